@@ -1,0 +1,1 @@
+"""Physics of mechopt: mechanisms, kinematics, feasibility, motion laws, analytic dynamics, pymunk simulation."""

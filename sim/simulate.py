@@ -1,0 +1,48 @@
+"""One entry point for both engines: ``simulate(design, mechanism, engine=...)``."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .analytic import simulate_analytic
+from .errors import InputError
+from .mechanism import FourBar
+from .pymunk_sim import simulate_pymunk
+from .result import SimulationResult
+
+ENGINES = ("pymunk", "analytic")
+
+
+def simulate(
+    design: np.ndarray | tuple[float, float, float], mechanism: FourBar, engine: str = "pymunk", **options
+) -> SimulationResult:
+    """Motor torque of one design over one cycle of the prescribed motion.
+
+    Parameters
+    ----------
+    design : (3,) array_like
+        |OA|, |AB|, |BC| in mm.
+    mechanism : FourBar
+        The fixed part of the mechanism (pivot C, inertias, load, motion).
+    engine : str
+        ``"pymunk"`` (rigid-body motion simulation, the stand-in for CAD) or ``"analytic"`` (inverse dynamics).
+    **options
+        Passed to :func:`sim.pymunk_sim.simulate_pymunk` or :func:`sim.analytic.simulate_analytic`.
+
+    Returns
+    -------
+    SimulationResult
+        Signed torque τ(t) (N·m), T_RMS, T_max, margins.
+
+    Raises
+    ------
+    InfeasibleDesignError
+        If the design cannot be driven through the stroke.
+    InputError
+        For an unknown engine or invalid lengths.
+    """
+    if engine == "pymunk":
+        return simulate_pymunk(design, mechanism, **options)
+    if engine == "analytic":
+        return simulate_analytic(design, mechanism, **options)
+    raise InputError(f"unknown engine {engine!r}; expected one of {', '.join(ENGINES)}")

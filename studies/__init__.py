@@ -1,0 +1,1 @@
+"""Workflow of mechopt: study definitions, sampling and storage, validation, plots and the command line."""

@@ -1,0 +1,1 @@
+"""Mathematics of mechopt: line plans, exponential fitting, Chebyshev blending, the sparse model, its search."""
