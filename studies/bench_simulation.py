@@ -68,7 +68,8 @@ def main() -> None:
     print("| quantity | median | min | max | target |")
     print("|---|---|---|---|---|")
     print(f"| pymunk, ms per design (steps per cycle {int(np.median(steps))} median, Richardson pair) | "
-          f"{1e3 * np.median(pym):.1f} | {1e3 * np.min(pym):.1f} | {1e3 * np.max(pym):.1f} | <= 30 (paper CAD: 85 000) |")
+          f"{1e3 * np.median(pym):.1f} | {1e3 * np.min(pym):.1f} | {1e3 * np.max(pym):.1f} | "
+          "<= 30 (paper CAD: 85 000) |")
     print(f"| pymunk vs analytic, relative T_RMS error | {np.median(errs):.1e} | {np.min(errs):.1e} | "
           f"{np.max(errs):.1e} | <= 5e-3 |")
     print(f"| analytic, ms per design (one call, 800 intervals) | {1e3 * np.median(ana):.2f} | "
