@@ -1,0 +1,44 @@
+"""The ground truth of the ventilator study: feasible, confirmed by pymunk, not beaten by a finer grid."""
+
+import json
+
+import numpy as np
+import pytest
+
+from sim.analytic import analytic_batch
+from sim.feasibility import check_feasibility
+from sim.pymunk_sim import simulate_pymunk
+from studies.ground_truth import compute_ground_truth, load_or_compute
+
+
+@pytest.fixture(scope="module")
+def truth(ventilator):
+    return compute_ground_truth(ventilator, step_mm=2.0)
+
+
+def test_optimum_is_feasible_and_confirmed_by_pymunk(ventilator, truth):
+    x = np.array(truth.x)
+    assert check_feasibility(x, ventilator.mechanism).feasible[0]
+    assert np.all((x >= ventilator.region[:, 0]) & (x <= ventilator.region[:, 1]))
+    assert truth.fun <= truth.grid_fun
+    assert simulate_pymunk(x, ventilator.mechanism).t_rms == pytest.approx(truth.fun, rel=5e-3)
+
+
+def test_finer_grid_around_it_finds_nothing_better(ventilator, truth):
+    x = np.array(truth.x)
+    axes = [np.linspace(c - 1.0, c + 1.0, 41) for c in x]  # 0.05 mm spacing, ±1 mm
+    mesh = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    inside = np.all((mesh >= ventilator.region[:, 0]) & (mesh <= ventilator.region[:, 1]), axis=1)
+    mesh = mesh[inside]
+    mesh = mesh[check_feasibility(mesh, ventilator.mechanism).feasible]
+    t_rms, _ = analytic_batch(mesh, ventilator.mechanism, check=False)
+    assert np.nanmin(t_rms) >= truth.fun * (1 - 1e-6)
+
+
+def test_cache_round_trip(ventilator, truth, tmp_path):
+    cache = tmp_path / "truth.json"
+    cache.write_text(json.dumps({"key": "stale"}))
+    first = load_or_compute(ventilator, cache, step_mm=2.0)
+    assert first.x == pytest.approx(truth.x)
+    second = load_or_compute(ventilator, cache, step_mm=2.0)  # read back, not recomputed
+    assert second.wall_time_s == first.wall_time_s
