@@ -1,0 +1,297 @@
+"""Automatic choice of the sampling lines: direction Δ and offsets δ(i) that cover the feasible region.
+
+The paper chose Δ and δ(i) by hand "to guarantee maximal coverage of the region of interest".  This module does it
+with a cheap search whose objective is the *coverage*: the fraction of the feasible region (estimated with seeded
+Monte-Carlo points of box ∩ feasible) lying inside the convex hull of the lines' feasible runs.
+
+For every candidate direction (the principal axes of the feasible point cloud, the coordinate axes, a few random
+directions, then small perturbations of the best one) the feasible cloud is projected on the normal plane; the line
+nodes are placed on the boundary of the projected 2-D convex hull, shrunk towards its centroid (several shrink
+factors and phases are tried), plus one node at the centroid when l >= 4.  Each line keeps its longest contiguous
+feasible run of samples, and the plan's coverage is the fraction of probe points in the hull of those runs.  The
+best plan is re-scored on an independent set of probe points, which is the coverage reported.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy.spatial import ConvexHull, QhullError
+
+from .errors import SurrogateError
+from .lines import FeasiblePredicate, LinePlan, normal_basis
+
+_SHRINKS = (0.9, 0.75, 0.6)
+_PHASES = (0.0, 0.5)
+_MIN_RUN = 4
+_RANK_POINTS = 4000
+
+
+@dataclass(frozen=True, eq=False)
+class PlanResult:
+    """Outcome of :func:`plan_lines`.
+
+    Attributes
+    ----------
+    plan : LinePlan
+        The lines, with ``k_ranges`` set to each line's feasible run (every line starts at k = 0, δ(0) = 0).
+    coverage : float
+        Fraction of the feasible region inside the hull of the runs (Monte-Carlo estimate on fresh points).
+    coverage_error : float
+        One standard error of that estimate.
+    n_samples : int
+        Total number of samples the plan asks for, Σ_i N_i.
+    message : str
+        Summary of the search.
+    """
+
+    plan: LinePlan
+    coverage: float
+    coverage_error: float
+    n_samples: int
+    message: str
+
+
+def coverage(plan: LinePlan, feasible_points: Any, k_ranges: Any | None = None) -> float:
+    """Fraction of points inside the hull of the plan's sampled segments.
+
+    Parameters
+    ----------
+    plan : LinePlan
+        Lines; ``k_ranges`` (argument or the plan's own) give the sampled segments.
+    feasible_points : (n, d) array
+        Points representative of the feasible region (e.g. uniform Monte-Carlo points of box ∩ feasible),
+        coordinates in the caller's units.
+    k_ranges : (l, 2) int array, optional
+        Inclusive index range per line; defaults to ``plan.k_ranges``.
+
+    Returns
+    -------
+    float
+        In [0, 1]; 0 when the hull is flat (fewer than d + 1 affinely independent end points).
+    """
+    pts = np.atleast_2d(np.asarray(feasible_points, dtype=float))
+    if pts.shape[0] == 0:
+        raise SurrogateError("coverage needs at least one feasible point, got none")
+    if pts.shape[1] != plan.dim:
+        raise SurrogateError(f"feasible points must have {plan.dim} columns, got {pts.shape[1]}")
+    try:
+        hull = plan.hull(k_ranges)
+    except SurrogateError:
+        if k_ranges is None and plan.k_ranges is None:
+            raise
+        return 0.0
+    return float(np.mean(hull.contains(pts)))
+
+
+def _probe(lower: np.ndarray, upper: np.ndarray, feasible: FeasiblePredicate, n: int, rng) -> np.ndarray:
+    X = lower + (upper - lower) * rng.random((n, lower.size))
+    ok = np.asarray(feasible(X), dtype=bool).reshape(-1)
+    if ok.size != n:
+        raise SurrogateError(f"feasible() must return {n} booleans, got {ok.size}")
+    return X[ok]
+
+
+def _boundary_nodes(poly: np.ndarray, n_boundary: int, shrink: float, phase: float) -> np.ndarray:
+    """Points at equal arc length on the convex polygon ``poly``, pulled towards its centroid by ``shrink``."""
+    centroid = poly.mean(axis=0)
+    closed = np.vstack([poly, poly[:1]])
+    seg = np.linalg.norm(np.diff(closed, axis=0), axis=1)
+    cum = np.concatenate(([0.0], np.cumsum(seg)))
+    s = (np.arange(n_boundary) + phase) / n_boundary * cum[-1]
+    idx = np.clip(np.searchsorted(cum, s, side="right") - 1, 0, seg.size - 1)
+    t = (s - cum[idx]) / np.where(seg[idx] > 0, seg[idx], 1.0)
+    pts = closed[idx] + t[:, None] * (closed[idx + 1] - closed[idx])
+    return centroid + shrink * (pts - centroid)
+
+
+def _simplified(poly: np.ndarray, n_keep: int) -> np.ndarray:
+    """Visvalingam simplification: drop the vertex spanning the smallest triangle until ``n_keep`` remain.
+
+    Keeps the corners of the region's cross-section, which equal-arc-length nodes tend to miss.
+    """
+    pts = poly.copy()
+    while pts.shape[0] > n_keep:
+        prev, nxt = np.roll(pts, 1, axis=0), np.roll(pts, -1, axis=0)
+        a, b = prev - pts, nxt - pts
+        area = 0.5 * np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
+        pts = np.delete(pts, int(np.argmin(area)), axis=0)
+    return pts
+
+
+def _node_sets(P: np.ndarray, n_lines: int) -> list[np.ndarray]:
+    """Candidate node layouts in the normal coordinates (m = 1 or 2)."""
+    out = []
+    if P.shape[1] == 1:
+        lo, hi = np.min(P), np.max(P)
+        mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+        for shrink in _SHRINKS:
+            out.append((mid + shrink * half * np.linspace(-1, 1, n_lines))[:, None])
+        return out
+    try:
+        poly = P[ConvexHull(P).vertices]  # counter-clockwise in 2-D
+    except QhullError:
+        return out
+    centroid = poly.mean(axis=0)
+    n_boundary = n_lines - 1 if n_lines >= 4 else n_lines
+    layouts = [_boundary_nodes(poly, n_boundary, 1.0, phase) for phase in _PHASES]
+    if poly.shape[0] >= n_boundary:
+        layouts.append(_simplified(poly, n_boundary))
+    for shrink in _SHRINKS:
+        for pts in layouts:
+            pts = centroid + shrink * (pts - centroid)
+            out.append(np.vstack([pts, centroid[None, :]]) if n_boundary < n_lines else pts)
+    return out
+
+
+def _evaluate(
+    u: np.ndarray,
+    spacing: float | None,
+    samples_per_line: int,
+    F: np.ndarray,
+    feasible: FeasiblePredicate,
+    n_lines: int,
+    min_samples: int,
+) -> tuple[float, LinePlan | None]:
+    """Best plan (and its coverage of the probe cloud F) for the unit direction u."""
+    E = normal_basis(u)
+    c = F.mean(axis=0)
+    t = (F - c) @ u
+    step = spacing if spacing is not None else (t.max() - t.min()) / max(samples_per_line - 1, 1)
+    if not step > 0:
+        return 0.0, None
+    delta = step * u
+    P = (F - c) @ E.T
+    k_lo = int(np.floor(t.min() / step)) - 1
+    k_hi = int(np.ceil(t.max() / step)) + 1
+    best = (0.0, None)
+    for nodes in _node_sets(P, n_lines):
+        base = LinePlan(delta, c, nodes @ E)
+        runs = [base.feasible_run(i, feasible, k_lo, k_hi) for i in range(n_lines)]
+        if min(r.size for r in runs) < min_samples:
+            continue
+        k0 = np.array([r[0] for r in runs])
+        # Re-anchor so every line starts at k = 0 and line 0 passes through the origin (paper convention).
+        origin = c + nodes[0] @ E + k0[0] * delta
+        offsets = (nodes - nodes[0]) @ E + (k0 - k0[0])[:, None] * delta
+        k_ranges = np.array([[0, r.size - 1] for r in runs])
+        plan = LinePlan(delta, origin, offsets, k_ranges=k_ranges)
+        cov = coverage(plan, F)
+        if cov > best[0]:
+            best = (cov, plan)
+    return best
+
+
+def plan_lines(
+    lower: Any,
+    upper: Any,
+    feasible: FeasiblePredicate,
+    n_lines: int = 7,
+    spacing: float | None = None,
+    samples_per_line: int = 90,
+    min_samples: int = 20,
+    n_probe: int = 20_000,
+    n_random: int = 6,
+    n_refine: int = 24,
+    seed: int = 0,
+) -> PlanResult:
+    """Propose Δ and δ(i) whose sampled segments cover as much of the feasible region as possible.
+
+    Parameters
+    ----------
+    lower, upper : (d,) array
+        Box bounds of the design coordinates (caller's units), d = 2 or 3.
+    feasible : callable
+        ``feasible(X: (n, d) array) -> (n,) bool array``; called on arrays of probe and line points.
+    n_lines : int
+        Number of lines l (>= d, so the hull has volume).
+    spacing : float, optional
+        ‖Δ‖, the distance between samples (caller's units).  Default: the feasible extent along Δ divided by
+        ``samples_per_line − 1``.
+    samples_per_line : int
+        Used only when ``spacing`` is None.
+    min_samples : int
+        Fewest samples a line's feasible run may have (shorter lines make poor exponential fits); candidate
+        layouts with a shorter line are discarded.
+    n_probe : int
+        Monte-Carlo points drawn in the box (twice: one set to choose, one to report the coverage).
+    n_random, n_refine : int
+        Number of random candidate directions and of random perturbations of the best one.
+    seed : int
+        Seed of the Monte-Carlo points and random directions.
+
+    Returns
+    -------
+    PlanResult
+
+    Raises
+    ------
+    SurrogateError
+        Bad bounds, d not in {2, 3}, too few lines, or a feasible region the probes (almost) never hit.
+    """
+    lo = np.asarray(lower, dtype=float).reshape(-1)
+    hi = np.asarray(upper, dtype=float).reshape(-1)
+    if lo.shape != hi.shape or lo.size not in (2, 3):
+        raise SurrogateError(f"lower and upper must be vectors of length 2 or 3, got {lo.shape} and {hi.shape}")
+    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi)) and np.all(hi > lo)):
+        raise SurrogateError(f"need finite bounds with upper > lower, got lower={lo.tolist()}, upper={hi.tolist()}")
+    dim = lo.size
+    if int(n_lines) < dim:
+        raise SurrogateError(f"n_lines must be >= d = {dim} for the hull to have volume, got {n_lines}")
+    if spacing is not None and not (np.isfinite(spacing) and spacing > 0):
+        raise SurrogateError(f"spacing must be a positive length, got {spacing!r}")
+    if int(samples_per_line) < _MIN_RUN:
+        raise SurrogateError(f"samples_per_line must be >= {_MIN_RUN}, got {samples_per_line}")
+    if not _MIN_RUN <= int(min_samples) <= int(samples_per_line):
+        raise SurrogateError(
+            f"min_samples must be between {_MIN_RUN} and samples_per_line = {samples_per_line}, got {min_samples}"
+        )
+    rng = np.random.default_rng(seed)
+    F = _probe(lo, hi, feasible, int(n_probe), rng)
+    if F.shape[0] < 10 * (dim + 1):
+        raise SurrogateError(
+            f"only {F.shape[0]} of {n_probe} probe points are feasible; enlarge n_probe or check the bounds"
+        )
+    # Ranking candidates needs only a few thousand points (standard error ~0.01); the full set is for reporting.
+    F_rank = F[:_RANK_POINTS]
+    # Work in box-normalised units so "principal axes" and "random directions" do not depend on the units.
+    width = hi - lo
+    Fn = (F - lo) / width
+    _, _, vt = np.linalg.svd(Fn - Fn.mean(axis=0), full_matrices=False)
+    cands = [v * width for v in vt] + list(np.eye(dim))
+    rand = rng.standard_normal((int(n_random), dim))
+    cands += [v * width for v in rand]
+    cands = [v / np.linalg.norm(v) for v in cands]
+
+    best_cov, best_plan, tried = 0.0, None, 0
+    for u in cands:
+        cov, plan = _evaluate(u, spacing, samples_per_line, F_rank, feasible, int(n_lines), int(min_samples))
+        tried += 1
+        if plan is not None and cov > best_cov:
+            best_cov, best_plan = cov, plan
+    if best_plan is None:
+        raise SurrogateError(
+            f"no direction gave {n_lines} lines with >= {min_samples} feasible samples each; "
+            "reduce min_samples or the spacing"
+        )
+    for angle in (0.15, 0.05):
+        for _ in range(int(n_refine) // 2):
+            u0 = best_plan.direction / best_plan.spacing
+            u = u0 + angle * rng.standard_normal(dim)
+            u /= np.linalg.norm(u)
+            cov, plan = _evaluate(u, spacing, samples_per_line, F_rank, feasible, int(n_lines), int(min_samples))
+            tried += 1
+            if plan is not None and cov > best_cov:
+                best_cov, best_plan = cov, plan
+
+    F2 = _probe(lo, hi, feasible, int(n_probe), rng)
+    cov = coverage(best_plan, F2) if F2.shape[0] else best_cov
+    err = float(np.sqrt(cov * (1 - cov) / max(F2.shape[0], 1)))
+    n_samples = int(np.sum(best_plan.k_ranges[:, 1] - best_plan.k_ranges[:, 0] + 1))
+    message = (
+        f"{tried} directions tried; coverage {cov:.3f} ± {err:.3f} of the feasible region "
+        f"with {n_lines} lines, {n_samples} samples, spacing {best_plan.spacing:.4g}"
+    )
+    return PlanResult(best_plan, cov, err, n_samples, message)
