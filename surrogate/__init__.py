@@ -1,6 +1,6 @@
 """Mathematics of mechopt: line plans, exponential fitting, Chebyshev blending, the sparse model, its search.
 
-The package implements Section 4 of Hermans et al. (paper 002): samples on l parallel lines, a 1-D exponential
+The package implements Section 4 of Ben Yahya et al. (2023, paper 002): samples on l parallel lines, a 1-D exponential
 fit per line, a Chebyshev blend of the line models across the normal plane, and an exhaustive search of the blended
 model.  It works on generic coordinates X in R^d (d = 3 for the four-bar; the caller maps designs to coordinates)
 and does not depend on the simulation code.
