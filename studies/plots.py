@@ -275,3 +275,47 @@ def animate_cycle(result: SimulationResult, study: Study, path: str | Path, fram
     anim.save(path, writer=PillowWriter(fps=12))
     plt.close(fig)
     return path
+
+
+def plot_validation(lines: list[dict], path: str | Path, fit_lines: list[tuple[np.ndarray, np.ndarray]] | None = None,
+                    model=None) -> Path:
+    """Simulated T_RMS against the model along fitting and held-out lines (paper Fig. 16).
+
+    Parameters
+    ----------
+    lines : list of dict
+        Held-out lines: ``designs_mm``, ``simulated``, ``predicted``.
+    path : str or Path
+        PNG file to write.
+    fit_lines : list of (designs, values), optional
+        The fitting lines, drawn too (the model interpolates them).
+    model : optional
+        The model, to draw its curve along the fitting lines.
+    """
+    from .design_space import to_u
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig, ax = plt.subplots(figsize=(11, 4.8))
+    x0 = 0
+    for i, (designs, values) in enumerate(fit_lines or []):
+        x = x0 + np.arange(len(values))
+        ax.plot(x, values, "o", ms=3, color="C3", label="fitting lines (simulated)" if i == 0 else None)
+        if model is not None:
+            ax.plot(x, model.predict(to_u(designs)), "-", color="C0", lw=1.2, label="model" if i == 0 else None)
+        x0 += len(values) + 4
+    for i, line in enumerate(lines):
+        sim, pred = np.asarray(line["simulated"]), np.asarray(line["predicted"])
+        x = x0 + np.arange(len(sim))
+        ax.plot(x, sim, "s", ms=3, color="C4", label="held-out lines (simulated)" if i == 0 else None)
+        ax.plot(x, pred, "-", color="C0", lw=1.2, label=None if fit_lines else ("model" if i == 0 else None))
+        x0 += len(sim) + 4
+    ax.set_xlabel("sample along the lines, one line after the other")
+    ax.set_ylabel("T_RMS (N·m)")
+    ax.set_title("Global model against simulations on its fitting lines and on held-out lines", fontsize=10)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

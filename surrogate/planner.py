@@ -121,13 +121,13 @@ def _simplified(poly: np.ndarray, n_keep: int) -> np.ndarray:
     return pts
 
 
-def _node_sets(P: np.ndarray, n_lines: int) -> list[np.ndarray]:
+def _node_sets(P: np.ndarray, n_lines: int, shrinks: tuple[float, ...] = _SHRINKS) -> list[np.ndarray]:
     """Candidate node layouts in the normal coordinates (m = 1 or 2)."""
     out = []
     if P.shape[1] == 1:
         lo, hi = np.min(P), np.max(P)
         mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
-        for shrink in _SHRINKS:
+        for shrink in shrinks:
             out.append((mid + shrink * half * np.linspace(-1, 1, n_lines))[:, None])
         return out
     try:
@@ -139,7 +139,7 @@ def _node_sets(P: np.ndarray, n_lines: int) -> list[np.ndarray]:
     layouts = [_boundary_nodes(poly, n_boundary, 1.0, phase) for phase in _PHASES]
     if poly.shape[0] >= n_boundary:
         layouts.append(_simplified(poly, n_boundary))
-    for shrink in _SHRINKS:
+    for shrink in shrinks:
         for pts in layouts:
             pts = centroid + shrink * (pts - centroid)
             out.append(np.vstack([pts, centroid[None, :]]) if n_boundary < n_lines else pts)
@@ -154,6 +154,7 @@ def _evaluate(
     feasible: FeasiblePredicate,
     n_lines: int,
     min_samples: int,
+    shrinks: tuple[float, ...] = _SHRINKS,
 ) -> tuple[float, LinePlan | None]:
     """Best plan (and its coverage of the probe cloud F) for the unit direction u."""
     E = normal_basis(u)
@@ -167,7 +168,7 @@ def _evaluate(
     k_lo = int(np.floor(t.min() / step)) - 1
     k_hi = int(np.ceil(t.max() / step)) + 1
     best = (0.0, None)
-    for nodes in _node_sets(P, n_lines):
+    for nodes in _node_sets(P, n_lines, shrinks):
         base = LinePlan(delta, c, nodes @ E)
         runs = [base.feasible_run(i, feasible, k_lo, k_hi) for i in range(n_lines)]
         if min(r.size for r in runs) < min_samples:
@@ -196,6 +197,8 @@ def plan_lines(
     n_random: int = 6,
     n_refine: int = 24,
     seed: int = 0,
+    sampleable: FeasiblePredicate | None = None,
+    directions: Any | None = None,
 ) -> PlanResult:
     """Propose Δ and δ(i) whose sampled segments cover as much of the feasible region as possible.
 
@@ -221,6 +224,13 @@ def plan_lines(
         Number of random candidate directions and of random perturbations of the best one.
     seed : int
         Seed of the Monte-Carlo points and random directions.
+    sampleable : callable, optional
+        Where lines may be sampled, a superset of ``feasible`` (default: ``feasible`` itself).  The objective can
+        often be simulated a little outside the region the optimum must lie in (beyond the box of interest, or a
+        design rule such as a toggle margin); lines that run on there all span the feasible region's whole extent
+        along Δ, so no line model has to extrapolate inside the hull, and nodes may sit on the region's boundary.
+    directions : sequence of (d,) arrays, optional
+        Try only these directions Δ (e.g. the paper's), without random or refined candidates.
 
     Returns
     -------
@@ -263,11 +273,18 @@ def plan_lines(
     cands = [v * width for v in vt] + list(np.eye(dim))
     rand = rng.standard_normal((int(n_random), dim))
     cands += [v * width for v in rand]
+    if directions is not None:
+        cands = [np.asarray(v, dtype=float).reshape(-1) for v in directions]
+        if any(v.shape != (dim,) or not np.linalg.norm(v) > 0 for v in cands):
+            raise SurrogateError(f"directions must be non-zero vectors of length {dim}")
+        n_refine = 0
     cands = [v / np.linalg.norm(v) for v in cands]
 
+    runs_on = feasible if sampleable is None else sampleable
+    shrinks = _SHRINKS if sampleable is None else (1.05, 1.0, *_SHRINKS)
     best_cov, best_plan, tried = 0.0, None, 0
     for u in cands:
-        cov, plan = _evaluate(u, spacing, samples_per_line, F_rank, feasible, int(n_lines), int(min_samples))
+        cov, plan = _evaluate(u, spacing, samples_per_line, F_rank, runs_on, int(n_lines), int(min_samples), shrinks)
         tried += 1
         if plan is not None and cov > best_cov:
             best_cov, best_plan = cov, plan
@@ -281,7 +298,9 @@ def plan_lines(
             u0 = best_plan.direction / best_plan.spacing
             u = u0 + angle * rng.standard_normal(dim)
             u /= np.linalg.norm(u)
-            cov, plan = _evaluate(u, spacing, samples_per_line, F_rank, feasible, int(n_lines), int(min_samples))
+            cov, plan = _evaluate(
+                u, spacing, samples_per_line, F_rank, runs_on, int(n_lines), int(min_samples), shrinks
+            )
             tried += 1
             if plan is not None and cov > best_cov:
                 best_cov, best_plan = cov, plan
