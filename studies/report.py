@@ -103,7 +103,7 @@ def _report_md(r: dict, study) -> str:
         f"Simulations: {r['simulations']['fit']} to fit the models (paper: 618) and {r['simulations']['validation']} "
         f"held-out ones to validate (paper: 1252). Samples simulated with the `{r['engine']}` engine.", "",
         "## Designs (the paper's Table 1, every design simulated here)", "",
-        "| design | |OA| (mm) | |AB| (mm) | |BC| (mm) | T_RMS (N·m) | T_max (N·m) | T_RMS savings | T_max savings "
+        "| design | OA (mm) | AB (mm) | BC (mm) | T_RMS (N·m) | T_max (N·m) | T_RMS savings | T_max savings "
         "| paper T_RMS | paper T_max | feasible here |",
         "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
