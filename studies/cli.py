@@ -173,6 +173,36 @@ def _cmd_feasible(args: argparse.Namespace) -> int:
     return 0
 
 
+def _int_list(text: str) -> list[int]:
+    try:
+        values = [int(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a comma-separated list of integers") from None
+    if not values or min(values) < 10:
+        raise argparse.ArgumentTypeError(f"budgets {text!r}: expected integers >= 10")
+    return values
+
+
+def _cmd_compare(args: argparse.Namespace) -> int:
+    from . import compare as cmp
+    from .definition import load_study
+    from .ground_truth import load_or_compute
+
+    study = load_study(args.study)
+    out = Path(args.out or f"{study.name}-study")
+    if args.seeds < 1:
+        raise MechoptError(f"--seeds {args.seeds}: expected at least 1")
+    print(f"ground truth of {study.name} (analytic brute force, {args.truth_grid:g} mm grid; cached in {out})")
+    truth = load_or_compute(study, out / f"ground_truth_{args.truth_grid:g}mm.json", args.truth_grid)
+    print(f"  T_RMS {truth.fun:.4f} N·m at {np.round(truth.x, 3).tolist()} mm")
+    methods = args.methods.split(",") if args.methods else None
+    runs = cmp.compare(study, truth, args.budgets, args.seeds, args.engine, methods)
+    md, fig = cmp.write(runs, truth, out, args.engine, args.seeds)
+    print(md.read_text())
+    print(f"table written to {md}, figure to {fig}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``mechopt`` with all its subcommands."""
     parser = argparse.ArgumentParser(
@@ -219,6 +249,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--lines", type=int, help="held-out lines (default 10)")
     p.add_argument("--refit", action="store_true", help="refit the model even if DIR/model.json exists")
     p.set_defaults(func=_cmd_validate)
+
+    p = sub.add_parser("compare", help="the surrogate against the literature's optimizers at equal simulation budgets")
+    _add_study(p)
+    p.add_argument("--budgets", type=_int_list, default=[50, 100, 200, 618, 1870],
+                   help="simulation budgets, comma separated (default 50,100,200,618,1870)")
+    p.add_argument("--seeds", type=int, default=5, help="seeds per method and budget (default 5)")
+    p.add_argument("--engine", choices=("pymunk", "analytic"), default="analytic",
+                   help="simulator the methods call (default analytic, standing in for pymunk)")
+    p.add_argument("--methods", help="comma-separated subset of the methods (default: all)")
+    p.add_argument("--out", metavar="DIR", help="output folder (default: STUDY-study)")
+    p.add_argument("--truth-grid", type=float, default=1.0, help="grid of the ground truth brute force (mm)")
+    p.set_defaults(func=_cmd_compare)
 
     p = sub.add_parser("feasible", help="plot the feasible region: slices and a 3-D view with the sampling lines")
     _add_study(p)

@@ -179,8 +179,10 @@ def _paper_plan(space: DesignSpace, options: SurrogateOptions) -> LinePlan:
 
 def build_stage(name: str, space: DesignSpace, options: SurrogateOptions, sampler: Sampler, n_lines: int,
                 samples_per_line: int, search_points: int, paper: bool = False,
-                min_samples: int | None = None, max_order: int | None = None) -> Stage:
-    """Plan, sample, fit and search one model over ``space``, then simulate its candidate."""
+                min_samples: int | None = None, max_order: int | None = None,
+                max_samples: int | None = None) -> Stage:
+    """Plan, sample, fit and search one model over ``space``, then simulate its candidate (``max_samples`` caps the
+    lines' samples, so that a budget is never exceeded)."""
     lo_u, hi_u = to_u(space.box[:, 0]), to_u(space.box[:, 1])
     min_samples = min(options.min_samples if min_samples is None else min_samples, samples_per_line)
     if paper:
@@ -189,6 +191,8 @@ def build_stage(name: str, space: DesignSpace, options: SurrogateOptions, sample
         res = plan_lines(lo_u, hi_u, space.feasible_u, n_lines=n_lines, samples_per_line=samples_per_line,
                          min_samples=min_samples, seed=options.seed, sampleable=space.sampleable_u)
         plan, cov = res.plan, res.coverage
+    if max_samples is not None:
+        plan = _trim(plan, max_samples)
     line_designs, line_values, samples, k_ranges = [], [], [], []
     all_designs = [from_u(plan.points(i, np.arange(k0, k1 + 1))) for i, (k0, k1) in enumerate(plan.k_ranges)]
     values, _ = sampler(np.vstack(all_designs), desc=f"{name}: {plan.n_lines} lines")
@@ -217,6 +221,19 @@ def build_stage(name: str, space: DesignSpace, options: SurrogateOptions, sample
                  line_designs=line_designs, line_values=line_values, candidate=candidate, predicted=predicted,
                  simulated=float(sim_rms[0]), simulated_max=float(sim_max[0]), search_time_s=search_time,
                  fit_time_s=fit_time, n_samples=int(sum(len(v) for v in line_values)))
+
+
+def _trim(plan: LinePlan, max_samples: int) -> LinePlan:
+    """Shorten every line about its middle by the same factor until the plan asks for at most ``max_samples``."""
+    kr = np.asarray(plan.k_ranges)
+    counts = kr[:, 1] - kr[:, 0] + 1
+    if counts.sum() <= max_samples:
+        return plan
+    keep = np.maximum(2, np.floor(counts * max_samples / counts.sum()).astype(int))
+    while keep.sum() > max_samples and keep.max() > 2:
+        keep[np.argmax(keep)] -= 1
+    start = kr[:, 0] + (counts - keep) // 2
+    return plan.with_k_ranges(np.column_stack([start, start + keep - 1]))
 
 
 def _longest_finite_run(values: np.ndarray) -> np.ndarray:
@@ -275,8 +292,9 @@ class PipelineResult:
 def optimize(space: DesignSpace, options: SurrogateOptions, sampler: Sampler, log=print) -> PipelineResult:
     """The global model and its candidate, then a constrained local refinement on the simulator if needed."""
     used_before = len(sampler.designs)
+    # The lines may use the budget but one simulation, which confirms the candidate.
     stage = build_stage("global", space, options, sampler, options.n_lines, options.samples_per_line,
-                        options.search_points, paper=options.plan == "paper")
+                        options.search_points, paper=options.plan == "paper", max_samples=options.budget - 1)
     log(f"  global model: {stage.n_samples} samples on {stage.plan.n_lines} lines (coverage {stage.coverage:.0%}), "
         f"orders {stage.model.orders}; candidate {np.round(stage.candidate, 3).tolist()} mm, model "
         f"{stage.predicted:.4f}, simulated {stage.simulated:.4f} N·m")
