@@ -221,3 +221,19 @@ def require_movable(design: np.ndarray, mechanism: FourBar) -> FeasibilityReport
     if not report.movable[0]:
         raise InfeasibleDesignError(report.message(0))
     return report
+
+
+def constraint_margins(designs: np.ndarray, mechanism: FourBar) -> np.ndarray:
+    """All constraint margins as one array for optimizers: (3,) -> (5,), (n, 3) -> (n, 5), >= 0 where satisfied.
+
+    Columns are those of :class:`FeasibilityReport` (mm, mm, mm, deg, deg).  A design whose margins are undefined
+    (never assembles) or whose lengths are not positive gets −1000 in every column, so that it counts as violated.
+    """
+    x = np.asarray(designs, dtype=float)
+    flat = np.atleast_2d(x)
+    valid = np.all(np.isfinite(flat) & (flat > 0), axis=1)
+    out = np.full((flat.shape[0], len(_COLUMNS)), -1e3)
+    if valid.any():
+        report = check_feasibility(flat[valid], mechanism)
+        out[valid] = np.nan_to_num(np.column_stack([getattr(report, c) for c in _COLUMNS]), nan=-1e3)
+    return out[0] if x.ndim == 1 else out

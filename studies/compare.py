@@ -17,7 +17,7 @@ import numpy as np
 
 from sim.analytic import simulate_analytic
 from sim.errors import InfeasibleDesignError
-from sim.feasibility import check_feasibility
+from sim.feasibility import check_feasibility, constraint_margins
 from sim.simulate import simulate
 from surrogate.errors import SurrogateError
 
@@ -26,8 +26,6 @@ from .definition import Study
 from .design_space import DesignSpace
 from .ground_truth import GroundTruth
 from .workflow import SurrogateOptions, optimize
-
-_MARGINS = ("assembly_start_mm", "assembly_end_mm", "assembly_stroke_mm", "monotonic_deg", "toggle_deg")
 
 #: Bayesian optimisation refits a Gaussian process on all samples at every step (cubic cost): it is run up to this
 #: budget only, as in the literature, where it is used for small budgets.
@@ -80,14 +78,7 @@ def make_problem(study: Study, engine: str, budget: int) -> CountedProblem:
 
     def margins(x: np.ndarray) -> np.ndarray:
         # One design (d,) -> (m,), or a batch (n, d) -> (n, m): the dense searches check thousands at once.
-        x = np.asarray(x, dtype=float)
-        flat = np.atleast_2d(x)
-        valid = np.all(np.isfinite(flat) & (flat > 0), axis=1)
-        out = np.full((flat.shape[0], len(_MARGINS)), -1e3)
-        if valid.any():
-            report = check_feasibility(flat[valid], mech)
-            out[valid] = np.nan_to_num(np.column_stack([getattr(report, n) for n in _MARGINS]), nan=-1e3)
-        return out[0] if x.ndim == 1 else out
+        return constraint_margins(x, mech)
 
     return CountedProblem(objective, study.region, budget, margins, failure_errors=(InfeasibleDesignError,),
                           vectorized_constraints=True)

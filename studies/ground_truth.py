@@ -18,12 +18,9 @@ import numpy as np
 from scipy.optimize import minimize
 
 from sim.analytic import analytic_batch
-from sim.feasibility import check_feasibility
+from sim.feasibility import check_feasibility, constraint_margins
 
 from .definition import Study
-
-#: Margins that must be >= 0 (the monotonic one > 0) for a design to be feasible.
-_MARGINS = ("assembly_start_mm", "assembly_end_mm", "assembly_stroke_mm", "monotonic_deg", "toggle_deg")
 
 
 @dataclass
@@ -96,10 +93,8 @@ def polish(study: Study, x0: np.ndarray) -> tuple[np.ndarray, float]:
         return float(t_rms[0]) if np.isfinite(t_rms[0]) else 1e6
 
     def margins(x):
-        report = check_feasibility(x, mech)
-        values = np.array([getattr(report, name)[0] for name in _MARGINS])
         # A hair of slack so that SLSQP, which converges onto the active constraint from either side, ends inside.
-        return np.nan_to_num(values, nan=-1e3) - 1e-7
+        return constraint_margins(x, mech) - 1e-7
 
     res = minimize(objective, x0, method="SLSQP", bounds=study.region,
                    constraints=[{"type": "ineq", "fun": margins}], options={"ftol": 1e-12, "maxiter": 200})

@@ -16,6 +16,14 @@ from sim.result import SimulationResult  # noqa: E402
 from .definition import Study  # noqa: E402
 
 
+def _save(fig, path: Path) -> Path:
+    """Write a finished figure (PNG, 110 dpi: readable at 100 % zoom) and release it."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
 def draw_mechanism(ax, design: np.ndarray, study: Study, psi: float, color: str, label: str | None = None,
                    alpha: float = 1.0) -> None:
     """Draw the four-bar O-A-B-C of ``design`` (mm) at output angle ``psi`` (rad) on ``ax``."""
@@ -68,9 +76,7 @@ def plot_simulation(result: SimulationResult, study: Study, path: str | Path) ->
     ax2.legend(loc="best", fontsize=9)
     ax2.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 _CONSTRAINTS = (
@@ -133,9 +139,7 @@ def plot_feasible_slices(study: Study, path: str | Path, oa_values: list[float] 
     fig.legend(handles=handles, fontsize=9, loc="lower center", ncol=len(handles), frameon=False)
     fig.suptitle(f"Feasible designs of study '{study.name}' (slices at fixed |OA|)", fontsize=11)
     fig.tight_layout(rect=(0, 0.07, 1, 1))
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 def plot_feasible_3d(study: Study, path: str | Path, lines: list[np.ndarray] | None = None,
@@ -190,9 +194,7 @@ def plot_feasible_3d(study: Study, path: str | Path, lines: list[np.ndarray] | N
     ax.set_title(f"Feasible region of '{study.name}', sampling lines and their convex hull", fontsize=10)
     ax.legend(loc="upper left", fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 def plot_torque_comparison(results: dict[str, SimulationResult], path: str | Path) -> Path:
@@ -209,9 +211,7 @@ def plot_torque_comparison(results: dict[str, SimulationResult], path: str | Pat
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 def plot_mechanisms(designs: dict[str, np.ndarray], study: Study, path: str | Path) -> Path:
@@ -230,9 +230,7 @@ def plot_mechanisms(designs: dict[str, np.ndarray], study: Study, path: str | Pa
         ax.legend(fontsize=8, loc="lower left")
     axes[0][0].set_ylabel("y (mm)")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 def animate_cycle(result: SimulationResult, study: Study, path: str | Path, frames: int = 40) -> Path:
@@ -316,6 +314,4 @@ def plot_validation(lines: list[dict], path: str | Path, fit_lines: list[tuple[n
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, path)

@@ -17,7 +17,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from sim.feasibility import check_feasibility
+from sim.feasibility import check_feasibility, constraint_margins
 from surrogate import LinePlan, SparseExponentialModel, exhaustive_search, plan_lines
 
 from .design_space import DesignSpace, from_u, to_u
@@ -329,15 +329,12 @@ def refine_locally(space: DesignSpace, sampler: Sampler, x0: np.ndarray, budget:
     from .baselines.problem import BudgetExhausted, CountedProblem
     from .baselines.slsqp import local_slsqp
 
-    names = ("assembly_start_mm", "assembly_end_mm", "assembly_stroke_mm", "monotonic_deg", "toggle_deg")
-
     def objective(x: np.ndarray) -> float:
         value, _ = sampler(np.asarray(x, dtype=float)[None, :], desc="refinement")
         return float(value[0])
 
     def margins(x: np.ndarray) -> np.ndarray:
-        report = check_feasibility(np.asarray(x, dtype=float), space.mechanism)
-        return np.nan_to_num(np.array([getattr(report, n)[0] for n in names]), nan=-1e3)
+        return constraint_margins(x, space.mechanism)
 
     progress, sampler.progress = sampler.progress, False
     t0 = time.perf_counter()
