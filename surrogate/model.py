@@ -98,7 +98,10 @@ class SparseExponentialModel:
         solver: str = "ls",
         max_order: int = 10,
         cond_max: float = 1e10,
+        extrapolation: str = "linear",
     ) -> None:
+        if extrapolation not in ("linear", "exponential"):
+            raise SurrogateError(f"extrapolation must be 'linear' or 'exponential', got {extrapolation!r}")
         if method not in METHODS:
             raise SurrogateError(f"method must be one of {METHODS}, got {method!r}")
         if solver not in SOLVERS:
@@ -108,6 +111,7 @@ class SparseExponentialModel:
         self.solver = solver
         self.max_order = int(max_order)
         self.cond_max = float(cond_max)
+        self.extrapolation = extrapolation
         self.plan: LinePlan | None = None
         self.fits: list[ExponentialFit] = []
         self.shifts = np.zeros(0)
@@ -222,17 +226,37 @@ class SparseExponentialModel:
         """Whether points X (caller's units, (n, d)) lie in the hull of the sampled segments, shape (n,)."""
         return self.hull.contains(X)
 
-    def line_values(self, d: Any) -> np.ndarray:
-        """The per-line models f_i at positions d (sample steps), shape (n, l)."""
-        self._require_fit()
+    def _local(self, d: Any) -> tuple[np.ndarray, np.ndarray]:
+        """Each line's local sample index k = d − shift, and k clipped to the line's sampled range."""
         d = np.asarray(d, dtype=float).reshape(-1)
-        return np.stack([f(d - s) for f, s in zip(self.fits, self.shifts, strict=True)], axis=1)
+        k = d[:, None] - self.shifts[None, :]
+        if self.extrapolation == "exponential":
+            return k, k
+        last = (self.plan.k_ranges[:, 1] - self.plan.k_ranges[:, 0]).astype(float)
+        return k, np.clip(k, 0.0, last[None, :])
+
+    def line_values(self, d: Any) -> np.ndarray:
+        """The per-line models f_i at positions d (sample steps), shape (n, l).
+
+        Within its samples a line's model is its sum of exponentials; beyond them, with ``extrapolation="linear"``
+        (the default), it continues along its end tangent.  Lines of unequal length would otherwise extrapolate
+        exponentials inside the hull, where a term with |z| > 1 grows without bound.
+        """
+        self._require_fit()
+        k, kc = self._local(d)
+        cols = []
+        for i, f in enumerate(self.fits):
+            value = f(kc[:, i])
+            if self.extrapolation == "linear":
+                value = value + f.derivative(kc[:, i]) * (k[:, i] - kc[:, i])
+            cols.append(value)
+        return np.stack(cols, axis=1)
 
     def line_derivatives(self, d: Any) -> np.ndarray:
         """df_i/dd at positions d, shape (n, l) (data units per sample step)."""
         self._require_fit()
-        d = np.asarray(d, dtype=float).reshape(-1)
-        return np.stack([f.derivative(d - s) for f, s in zip(self.fits, self.shifts, strict=True)], axis=1)
+        _, kc = self._local(d)
+        return np.stack([f.derivative(kc[:, i]) for i, f in enumerate(self.fits)], axis=1)
 
     # ------------------------------------------------------------------------------------------- evaluation
     def _points(self, X: Any) -> tuple[np.ndarray, bool]:
@@ -307,6 +331,7 @@ class SparseExponentialModel:
                 "solver": self.solver,
                 "max_order": self.max_order,
                 "cond_max": self.cond_max,
+                "extrapolation": self.extrapolation,
             },
             "plan": self.plan.to_dict(),
             "shifts": self.shifts.tolist(),

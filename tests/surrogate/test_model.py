@@ -57,7 +57,7 @@ def test_reproduces_samples_and_its_model_class(method, solver):
     T = class_function(plan)
     ks = np.arange(-3, 40)
     data = sample(plan, T, ks)
-    model = SparseExponentialModel(method=method, solver=solver).fit(plan, data)
+    model = SparseExponentialModel(method=method, solver=solver, extrapolation="exponential").fit(plan, data)
     assert model.l == 7 and model.orders == [4, 4, 4, 4, 3, 4, 4]  # c_0 vanishes at node (−10, 0)
     # Every sample to 1e-9 relative.
     for i, (k, v) in enumerate(data):
@@ -79,7 +79,9 @@ def test_restriction_to_a_line_is_that_lines_fit_even_with_noise():
 
 def test_terms_are_inspectable():
     plan = class_plan()
-    model = SparseExponentialModel().fit(plan, sample(plan, class_function(plan), np.arange(5, 40)))
+    model = SparseExponentialModel(extrapolation="exponential").fit(
+        plan, sample(plan, class_function(plan), np.arange(5, 40))
+    )
     d = np.linspace(-5.0, 50.0, 23)
     # f_i(d) = Re Σ α_j exp(λ_j d) with the published coefficients and exponents (Eq. 15 shift included).
     rebuilt = np.stack(
@@ -92,6 +94,22 @@ def test_terms_are_inspectable():
             if np.min(np.abs(lam - true)) > 1e-7:
                 # Line 4 lacks the first term; every other exponent must be found.
                 assert np.isclose(true, LAMBDAS[0])
+
+
+def test_linear_continuation_beyond_a_lines_samples():
+    # Default guard: beyond its samples a line's model continues along its end tangent (C1), inside it is unchanged.
+    plan = class_plan()
+    data = sample(plan, class_function(plan), np.arange(5, 40))
+    pure = SparseExponentialModel(extrapolation="exponential").fit(plan, data)
+    guarded = SparseExponentialModel().fit(plan, data)
+    inside = np.linspace(0.0, 34.0, 35) + guarded.shifts[0]
+    np.testing.assert_allclose(guarded.line_values(inside)[:, 0], pure.line_values(inside)[:, 0], rtol=1e-12)
+    end = guarded.shifts[0] + 34.0
+    beyond = end + np.array([1.0, 5.0, 20.0])
+    slope = pure.line_derivatives([end])[0, 0]
+    np.testing.assert_allclose(guarded.line_values(beyond)[:, 0],
+                               pure.line_values([end])[0, 0] + slope * (beyond - end), rtol=1e-12)
+    np.testing.assert_allclose(guarded.line_derivatives(beyond)[:, 0], slope, rtol=1e-12)
 
 
 def test_gradient_matches_finite_differences():
