@@ -21,6 +21,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--steps", default="2,1,0.5", help="grid spacings in mm, comma separated")
     parser.add_argument("--study", default="ventilator")
+    parser.add_argument("--starts", type=int, default=30, help="random feasible starts of the basin check")
     args = parser.parse_args()
     study = load_study(args.study)
     analytic_batch(study.region[:, 0][None, :] + 1.0, study.mechanism)  # warm-up
@@ -36,6 +37,28 @@ def main() -> None:
         fmt = lambda v: "(" + ", ".join(f"{c:.3f}" for c in v) + ")"  # noqa: E731
         print(f"| {step:g} | {g.n_evaluated:,} | {g.n_feasible:,} | {fmt(g.grid_x)} | {g.grid_fun:.5f} | "
               f"{fmt(g.x)} | {g.fun:.6f} | {g.n_evaluated / wall:,.0f} | {wall:.1f} |")
+
+
+    print()
+    print(basin_check(study, args.starts))
+
+
+def basin_check(study, n_starts: int, seed: int = 5) -> str:
+    """Run SLSQP on the analytic engine from random feasible starts and count the distinct optima it ends at."""
+    from collections import Counter
+
+    import numpy as np
+
+    from sim.feasibility import feasible_mask
+
+    from .ground_truth import polish
+
+    rng = np.random.default_rng(seed)
+    starts = rng.uniform(study.region[:, 0], study.region[:, 1], size=(100 * n_starts, 3))
+    starts = starts[feasible_mask(starts, study.mechanism)][:n_starts]
+    ends = Counter(round(polish(study, x0)[1], 4) for x0 in starts)
+    found = ", ".join(f"{f:.4f} N·m ×{n}" for f, n in sorted(ends.items()))
+    return f"basin check: SLSQP from {len(starts)} random feasible starts ends at {found}"
 
 
 if __name__ == "__main__":
