@@ -97,12 +97,10 @@ def _cmd_study(args: argparse.Namespace) -> int:
 
 
 def _cmd_validate(args: argparse.Namespace) -> int:
-    from surrogate import SparseExponentialModel
-
     from .definition import load_study
     from .plots import plot_validation
     from .run import make_space, open_sampler
-    from .workflow import build_stage, validate
+    from .workflow import ObjectiveModel, build_stage, validate
 
     study = load_study(args.study)
     options = _options(args, study)
@@ -116,7 +114,7 @@ def _cmd_validate(args: argparse.Namespace) -> int:
         model_path = out / "model.json"
         fit_lines = None
         if model_path.is_file() and not args.refit:
-            model = SparseExponentialModel.load(model_path)
+            model = ObjectiveModel.load(model_path)
             print(f"model read from {model_path}")
         else:
             stage = build_stage("global", space, options, sampler, options.n_lines, options.samples_per_line,
@@ -227,8 +225,9 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--scheduler", metavar="ADDR", help="Dask scheduler address tcp://HOST:PORT (dask extra)")
         p.add_argument("--store", metavar="FILE", help="SQLite sample store (default: DIR/samples.sqlite)")
         p.add_argument("--engine", choices=("pymunk", "analytic"), default="pymunk", help="simulation engine")
-        p.add_argument("--plan", choices=("auto", "paper"), help="line plan: automatic or the paper's Δ and origin")
-        p.add_argument("--lines-fit", type=int, help="lines of the global model (default 7)")
+        p.add_argument("--plan", choices=("auto", "paper"),
+                       help="line plan: automatic, or the paper's Δ, spacing, origin and 7 lines")
+        p.add_argument("--lines-fit", type=int, help="lines of the global model (default: the study's; ventilator 21)")
         p.add_argument("--samples-per-line", type=int, help="target samples per line of the global model")
         p.add_argument("--search-points", type=int, help="grid points of the exhaustive search (default 10 million)")
         p.add_argument("--no-refine", action="store_true", help="report the model's candidate without local refinement")

@@ -54,7 +54,7 @@ class DesignSpace:
 
     mechanism: FourBar
     box: np.ndarray
-    toggle_relax_deg: float = 10.0
+    toggle_relax_deg: float = 5.0
     box_extend: float = 0.15
     n_check: int = 61
 

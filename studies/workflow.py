@@ -12,8 +12,10 @@
 
 from __future__ import annotations
 
+import json
 import time
 from dataclasses import asdict, dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -34,6 +36,13 @@ class SurrogateOptions:
     ----------
     plan : str
         ``"auto"`` (planner) or ``"paper"`` (the study's ``paper_direction`` and ``paper_origin``, U coordinates).
+    target : str
+        What the lines' exponential sums model: ``"mean_square"`` (T_RMS², the mean of τ² over the cycle, whose
+        square root is taken after blending) or ``"rms"`` (T_RMS itself, as the paper).  T_RMS² is the smoother
+        function of the design: on the ventilator the blend's held-out error is halved.
+    layout : str
+        How the planner places the line nodes: ``"fekete"`` (approximate Fekete points, an accurate blend for any
+        l) or ``"boundary"`` (on the region's outline, the largest hull for l = 7); see :mod:`surrogate.planner`.
     n_lines, samples_per_line, min_samples : int
         Lines of the global model, target samples per line, fewest samples a line may have.
     max_order : int
@@ -41,7 +50,10 @@ class SurrogateOptions:
     search_points : int
         Grid points of the global exhaustive search (the paper: 10 million).
     refine : bool
-        Refine the model's candidate by a constrained local search on the simulator when they disagree.
+        Refine the model's candidate by a constrained local search on the simulator.
+    fd_step : float
+        Finite-difference step of that search, as a fraction of the region's width: large enough to step over
+        the simulator's numerical noise (pymunk: ~1e-4 relative, smooth), small enough for accurate gradients.
     budget : int
         Most simulations in all: the model's lines, the confirmation and the refinement (the paper used 618).
     rel_tol : float
@@ -57,17 +69,20 @@ class SurrogateOptions:
     """
 
     plan: str = "auto"
-    n_lines: int = 7
-    samples_per_line: int = 40
-    min_samples: int = 24
+    target: str = "mean_square"
+    layout: str = "fekete"
+    n_lines: int = 21
+    samples_per_line: int = 25
+    min_samples: int = 20
     max_order: int = 5
     search_points: int = 10_000_000
     refine: bool = True
+    fd_step: float = 1e-3
     budget: int = 600
     rel_tol: float = 0.005
     validation_lines: int = 10
     validation_points: int = 30
-    toggle_relax_deg: float = 10.0
+    toggle_relax_deg: float = 5.0
     box_extend: float = 0.15
     paper_direction: list[float] = field(default_factory=lambda: [0.0, 0.920, 0.503])
     paper_origin: list[float] = field(default_factory=lambda: [31.000, 257.859, 72.705])
@@ -92,10 +107,51 @@ class SurrogateOptions:
         opts = cls(**values)
         if opts.plan not in ("auto", "paper"):
             raise StudyError(f"key surrogate.plan = {opts.plan!r}; expected 'auto' or 'paper'")
+        if opts.layout not in ("fekete", "boundary"):
+            raise StudyError(f"key surrogate.layout = {opts.layout!r}; expected 'fekete' or 'boundary'")
+        if opts.target not in TARGETS:
+            raise StudyError(f"key surrogate.target = {opts.target!r}; expected one of {', '.join(TARGETS)}")
         for key in ("n_lines", "samples_per_line", "min_samples", "max_order", "search_points", "budget"):
             if getattr(opts, key) < 1:
                 raise StudyError(f"key surrogate.{key} = {getattr(opts, key)!r} must be >= 1")
         return opts
+
+
+TARGETS = ("mean_square", "rms")
+
+
+class ObjectiveModel:
+    """The sparse model of T_RMS or of T_RMS², answering in T_RMS (N·m) either way.
+
+    Everything but :meth:`predict` (plan, orders, hull, terms...) is the underlying
+    :class:`~surrogate.SparseExponentialModel`'s.
+    """
+
+    def __init__(self, model: SparseExponentialModel, target: str = "mean_square"):
+        if target not in TARGETS:
+            raise ValueError(f"target must be one of {TARGETS}, got {target!r}")
+        self.model = model
+        self.target = target
+
+    def __getattr__(self, name: str):
+        if name == "model":  # not set yet (e.g. while unpickling): no recursion
+            raise AttributeError(name)
+        return getattr(self.model, name)
+
+    def predict(self, U: np.ndarray) -> np.ndarray:
+        """T_RMS (N·m) at paper coordinates U (n, 3)."""
+        value = np.asarray(self.model.predict(U), dtype=float)
+        return np.sqrt(np.maximum(value, 0.0)) if self.target == "mean_square" else value
+
+    def save(self, path: Path) -> None:
+        """JSON file with the target and the model."""
+        Path(path).write_text(json.dumps({"target": self.target, "model": self.model.to_dict()}))
+
+    @classmethod
+    def load(cls, path: Path) -> ObjectiveModel:
+        """Inverse of :meth:`save`."""
+        data = json.loads(Path(path).read_text())
+        return cls(SparseExponentialModel.from_dict(data["model"]), data["target"])
 
 
 class Sampler:
@@ -135,7 +191,7 @@ class Stage:
     box: np.ndarray
     plan: LinePlan
     coverage: float
-    model: SparseExponentialModel
+    model: ObjectiveModel
     line_designs: list[np.ndarray]
     line_values: list[np.ndarray]
     candidate: np.ndarray
@@ -163,10 +219,15 @@ class Stage:
         }
 
 
+#: Lines of the paper's plan (its Section 4: l = 7, quadratic blend plus one cubic term).
+PAPER_LINES = 7
+
+
 def _paper_plan(space: DesignSpace, options: SurrogateOptions) -> LinePlan:
-    """The paper's Δ and origin (U coordinates) with offsets from the planner restricted to that direction."""
+    """The paper's Δ, spacing ‖Δ‖, origin (U coordinates) and l = 7, with offsets from the planner in that
+    direction."""
     direction = np.asarray(options.paper_direction, dtype=float)
-    res = plan_lines(to_u(space.box[:, 0]), to_u(space.box[:, 1]), space.feasible_u, n_lines=options.n_lines,
+    res = plan_lines(to_u(space.box[:, 0]), to_u(space.box[:, 1]), space.feasible_u, n_lines=PAPER_LINES,
                      spacing=float(np.linalg.norm(direction)), samples_per_line=options.samples_per_line,
                      min_samples=min(options.min_samples, options.samples_per_line), n_random=0, n_refine=0,
                      seed=options.seed, sampleable=space.sampleable_u, directions=[direction])
@@ -189,7 +250,8 @@ def build_stage(name: str, space: DesignSpace, options: SurrogateOptions, sample
         plan, cov = _paper_plan(space, options)
     else:
         res = plan_lines(lo_u, hi_u, space.feasible_u, n_lines=n_lines, samples_per_line=samples_per_line,
-                         min_samples=min_samples, seed=options.seed, sampleable=space.sampleable_u)
+                         min_samples=min_samples, seed=options.seed, sampleable=space.sampleable_u,
+                         layout=options.layout)
         plan, cov = res.plan, res.coverage
     if max_samples is not None:
         plan = _trim(plan, max_samples)
@@ -203,16 +265,20 @@ def build_stage(name: str, space: DesignSpace, options: SurrogateOptions, sample
         ks = np.arange(plan.k_ranges[i][0], plan.k_ranges[i][1] + 1)
         run = _longest_finite_run(v)  # a failed simulation splits a line: fit its longest clean stretch
         ks, v, designs = ks[run], v[run], designs[run]
-        samples.append((ks, v))
+        samples.append((ks, v * v if options.target == "mean_square" else v))
         k_ranges.append([int(ks[0]), int(ks[-1])])
         line_designs.append(designs)
         line_values.append(v)
     plan = plan.with_k_ranges(np.array(k_ranges))
     t0 = time.perf_counter()
-    model = SparseExponentialModel(max_order=options.max_order if max_order is None else max_order).fit(plan, samples)
+    model = ObjectiveModel(
+        SparseExponentialModel(max_order=options.max_order if max_order is None else max_order).fit(plan, samples),
+        options.target,
+    )
     fit_time = time.perf_counter() - t0
     t0 = time.perf_counter()
-    found = exhaustive_search(model, feasible=space.feasible_u_fast, n_points=search_points)
+    # Minimising T_RMS² is minimising T_RMS: the search runs on the underlying model.
+    found = exhaustive_search(model.model, feasible=space.feasible_u_fast, n_points=search_points)
     search_time = time.perf_counter() - t0
     candidate = _make_feasible(space, from_u(found.x), line_designs)
     predicted = float(model.predict(to_u(candidate)[None, :])[0])
@@ -304,8 +370,9 @@ def optimize(space: DesignSpace, options: SurrogateOptions, sampler: Sampler, lo
     remaining = options.budget - (len(sampler.designs) - used_before)
     # Agreement at one point does not prove the candidate optimal (the model may be off elsewhere), so the local
     # search always runs when there is budget: at a true optimum it stops after a few gradient evaluations.
-    if options.refine and remaining > 8:
-        refined = refine_locally(space, sampler, stage.candidate, remaining, stage)
+    # One forward-difference gradient costs d simulations beyond the start: below that a local search cannot move.
+    if options.refine and remaining > space.box.shape[0] + 1:
+        refined = refine_locally(space, sampler, stage.candidate, remaining, stage, options.fd_step)
         stages.append(refined)
         log(f"  refinement: {refined.n_samples} simulations of a constrained local search (SLSQP) from the "
             f"candidate; design {np.round(refined.candidate, 3).tolist()} mm, simulated {refined.simulated:.4f} N·m")
@@ -319,7 +386,8 @@ def optimize(space: DesignSpace, options: SurrogateOptions, sampler: Sampler, lo
                           sampling_time_s=sampler.sampling_time_s, message=message)
 
 
-def refine_locally(space: DesignSpace, sampler: Sampler, x0: np.ndarray, budget: int, model_stage: Stage) -> Stage:
+def refine_locally(space: DesignSpace, sampler: Sampler, x0: np.ndarray, budget: int, model_stage: Stage,
+                   fd_step: float = 1e-3) -> Stage:
     """SLSQP on the simulator itself from ``x0``, with the feasibility margins as constraints (budgeted).
 
     Where the global model is off by more than the tolerance, its candidate is only a good start: the objective
@@ -340,7 +408,7 @@ def refine_locally(space: DesignSpace, sampler: Sampler, x0: np.ndarray, budget:
     t0 = time.perf_counter()
     problem = CountedProblem(objective, space.box, budget, margins)
     try:
-        local_slsqp(problem, x0, fd_step=1e-3)
+        local_slsqp(problem, x0, fd_step=fd_step)
     except BudgetExhausted:
         pass
     finally:
@@ -370,7 +438,7 @@ class Validation:
         return asdict(self)
 
 
-def validation_lines(model: SparseExponentialModel, space: DesignSpace, n_lines: int, n_points: int,
+def validation_lines(model: ObjectiveModel, space: DesignSpace, n_lines: int, n_points: int,
                      seed: int) -> list[np.ndarray]:
     """Held-out lines inside the model's hull ∩ feasible region, in directions at least 30° from Δ (designs, mm)."""
     rng = np.random.default_rng(seed + 1000)
@@ -406,7 +474,7 @@ def validation_lines(model: SparseExponentialModel, space: DesignSpace, n_lines:
     return lines
 
 
-def validate(model: SparseExponentialModel, space: DesignSpace, sampler: Sampler, n_lines: int, n_points: int,
+def validate(model: ObjectiveModel, space: DesignSpace, sampler: Sampler, n_lines: int, n_points: int,
              seed: int, t_min: float | None = None) -> Validation:
     """Simulate held-out lines and compare with the model: RMSE overall, for T <= 2 T_min, and max error."""
     lines = validation_lines(model, space, n_lines, n_points, seed)

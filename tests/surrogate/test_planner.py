@@ -92,3 +92,42 @@ def test_bad_input_raises_one_line_error(args, kwargs, pattern):
 def test_empty_feasible_region_is_reported():
     with pytest.raises(SurrogateError, match=r"only 0 of 2000 probe points are feasible"):
         plan_lines([0, 0, 0], [1, 1, 1], lambda X: np.zeros(len(X), bool), n_probe=2000)
+
+
+def test_fekete_points_in_one_dimension_are_close_to_gauss_lobatto():
+    # The Fekete points of degree-4 polynomials on [-1, 1] are the Gauss-Lobatto nodes 0, ±sqrt(3/7), ±1; the
+    # greedy (approximate) ones chosen from a 0.01 grid land within 0.03 of them.
+    from surrogate.planner import fekete_points
+
+    x = np.linspace(-1.0, 1.0, 201)[:, None]
+    chosen = np.sort(x[fekete_points(x, 5)].ravel())
+    exact = np.array([-1.0, -np.sqrt(3 / 7), 0.0, np.sqrt(3 / 7), 1.0])
+    assert np.max(np.abs(chosen - exact)) < 0.03
+
+
+def test_fekete_layout_keeps_the_blend_well_conditioned_where_the_boundary_layout_does_not():
+    # 15 lines (a quartic blend) over a box region: the Lebesgue constant of the blend over the hull, max Σ|L_i|,
+    # bounds how much line errors are amplified.  Fekete nodes keep it near that of the square's own Fekete points
+    # (~5); nodes on the outline plus the centroid leave a quartic nearly undetermined inside (> 30).
+    from surrogate.blending import ChebyshevBlend
+
+    lo, hi = np.array([0.2, 0.1, 0.3]), np.array([0.8, 0.6, 0.9])
+
+    def feasible(X):
+        return np.all((X >= lo) & (X <= hi), axis=1)
+
+    pts = lo + (hi - lo) * np.random.default_rng(0).random((20_000, 3))
+    lebesgue = {}
+    for layout in ("fekete", "boundary"):
+        result = plan_lines([0, 0, 0], [1, 1, 1], feasible, n_lines=15, samples_per_line=30, min_samples=10, seed=1,
+                            layout=layout)
+        inside = pts[result.plan.hull_contains(pts)]
+        blend = ChebyshevBlend(result.plan.line_nodes())
+        lebesgue[layout] = np.abs(blend.lagrange(result.plan.normal_coordinates(inside))).sum(axis=1).max()
+        assert result.coverage > 0.8, result.message
+    assert lebesgue["fekete"] < 8.0 and lebesgue["boundary"] > 30.0, lebesgue
+
+
+def test_unknown_layout_is_a_one_line_error():
+    with pytest.raises(SurrogateError, match=r"layout must be one of fekete, boundary, got 'grid'"):
+        plan_lines([0, 0, 0], [1, 1, 1], lambda X: np.ones(len(X), bool), layout="grid")
