@@ -101,7 +101,8 @@ def run_study(study: Study, out: Path, options: SurrogateOptions, engine: str = 
         timings["sampling_s"] = sampler.sampling_time_s
         timings["fit_s"] = sum(s.fit_time_s for s in pipeline.stages)
         timings["search_s"] = sum(s.search_time_s for s in pipeline.stages)
-        log(f"  {pipeline.message}; {pipeline.n_fit_simulations} simulations used for fitting")
+        log(f"  {pipeline.message}; {pipeline.n_fit_simulations} simulations in all ({pipeline.stages[0].n_samples} on "
+            f"the lines of the global model)")
         t0 = time.perf_counter()
         before = sampler.sampling_time_s
         validation = validate(pipeline.stages[0].model, space, sampler, options.validation_lines,
@@ -153,6 +154,8 @@ def summary_lines(run: StudyRun) -> list[str]:
         gap = best.t_rms / run.truth.fun - 1
         lines.append(f"ground truth (analytic brute force, {run.truth.step_mm:g} mm grid + polish): "
                      f"{np.round(run.truth.x, 3).tolist()} mm, T_RMS {run.truth.fun:.4f} N·m; gap {100 * gap:+.2f} %")
-    lines.append(f"simulations: {run.pipeline.n_fit_simulations} to fit, {run.validation.n_points} to validate; "
+    lines.append(f"simulations: {run.pipeline.stages[0].n_samples} to fit the global model, "
+                 f"{run.pipeline.n_fit_simulations - run.pipeline.stages[0].n_samples} to confirm and refine, "
+                 f"{run.validation.n_points} to validate; "
                  f"total {run.timings['total_s']:.1f} s; outputs in {run.out}")
     return lines

@@ -10,7 +10,7 @@ from studies.cli import EXIT_ERROR, main
 
 def test_compare_small(tmp_path, capsys):
     args = ["compare", "--budgets", "40,60", "--seeds", "2", "--out", str(tmp_path), "--truth-grid", "2",
-            "--methods", "mechopt,rbf_same_samples,differential_evolution,slsqp,sce_ua"]
+            "--methods", "mechopt,rbf_same_samples,kriging_same_samples,differential_evolution,slsqp,sce_ua"]
     assert main(args) == 0
     out = capsys.readouterr().out
     assert "| mechopt | 40 |" in out and "| slsqp | 60 |" in out
@@ -21,8 +21,8 @@ def test_compare_small(tmp_path, capsys):
         if run["x"] is not None:
             assert run["t_rms"] >= truth * (1 - 1e-6)  # nobody beats the ground truth
             assert run["gap_pct"] == pytest.approx(100 * (run["t_rms"] / truth - 1))
-    assert {r["method"] for r in data["rows"]} == {"mechopt", "rbf_same_samples", "differential_evolution", "slsqp",
-                                                   "sce_ua"}
+    assert {r["method"] for r in data["rows"]} == {"mechopt", "rbf_same_samples", "kriging_same_samples",
+                                                   "differential_evolution", "slsqp", "sce_ua"}
     png = (tmp_path / "figures" / "compare_gaps.png").read_bytes()
     assert png[:4] == b"\x89PNG" and len(png) > 20_000
     # Seeded: the same command gives the same table.
