@@ -48,6 +48,27 @@ def test_designs_straddling_a_constraint(mechanism, column, base, index, lo, hi)
     assert "infeasible" in report.message(1)
 
 
+def _two_defect_geometry():
+    """A geometry (found by a seeded search) whose crank reverses twice inside its wide stroke."""
+    xc, yc, oa, ab, bc, p0, p1 = (-58.412148423603014, -76.58683626705267, 148.4811913735035, 175.11614336687592,
+                                  64.7898180069846, -0.6807893598587111, 1.5407725903829683)
+    mech = FourBar((xc, yc), 1e-3, 0.1, MotionLaw(p0, p1, 0.2), RockerLoad.constant(0.0), toggle_margin_deg=0.0)
+    return mech, (oa, ab, bc)
+
+
+def test_design_straddling_assembly_inside_the_stroke():
+    # A longer rocker makes |OB| exceed |OA| + |AB| in the middle of the stroke while both ends still assemble:
+    # the end-point test of Eq. 7 passes on both sides, the along-stroke margin changes sign.
+    mech, (oa, ab, bc) = _two_defect_geometry()
+    inside, outside = _straddle(mech, "assembly_stroke_mm", (oa, ab, bc), 2, 1.05 * bc, 1.1 * bc)
+    report = check_feasibility(np.vstack([inside, outside]), mech)
+    assert report.assembly_stroke_mm[0] > 0 > report.assembly_stroke_mm[1]
+    np.testing.assert_allclose(np.abs(report.assembly_stroke_mm), 0.01, rtol=0.3)
+    assert np.all(report.assembly_start_mm > 1) and np.all(report.assembly_end_mm > 1)  # Eq. 7 sees nothing
+    assert not report.movable[1]
+    assert "not assemblable inside the stroke" in report.message(1)
+
+
 def test_assembly_margin_by_hand(mechanism):
     # At ψ_end, |OB| is known in closed form; the margin is |OA| + |AB| − |OB| for a long-reaching design.
     oa, ab, bc = 40.0, 80.0, 270.0
@@ -58,13 +79,10 @@ def test_assembly_margin_by_hand(mechanism):
 
 
 def test_two_defects_between_the_ends_are_caught():
-    # A geometry (found by a seeded search) whose crank reverses twice inside the stroke: θ' has the same sign at
-    # both ends, so the end-point test of Eq. 8 passes, yet the crank is not monotonic.
-    xc, yc, oa, ab, bc, p0, p1 = (-58.412148423603014, -76.58683626705267, 148.4811913735035, 175.11614336687592,
-                                  64.7898180069846, -0.6807893598587111, 1.5407725903829683)
-    mech = FourBar((xc, yc), 1e-3, 0.1, MotionLaw(p0, p1, 0.2), RockerLoad.constant(0.0), toggle_margin_deg=0.0)
-    psi = np.linspace(p0, p1, 4001)
-    _, d1, _ = crank_angle((oa, ab, bc), (xc, yc), psi)
+    # θ' has the same sign at both ends, so the end-point test of Eq. 8 passes, yet the crank is not monotonic.
+    mech, (oa, ab, bc) = _two_defect_geometry()
+    psi = np.linspace(mech.psi_start, mech.psi_end, 4001)
+    _, d1, _ = crank_angle((oa, ab, bc), mech.pivot_c, psi)
     signs = np.sign(d1)
     assert np.all(np.isfinite(d1))
     assert signs[0] == signs[-1]  # Eq. 8 sees nothing
