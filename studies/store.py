@@ -15,6 +15,7 @@ import hashlib
 import json
 import math
 import sqlite3
+import time
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
@@ -316,25 +317,45 @@ class SampleStore:
         except (OSError, sqlite3.Error) as exc:
             raise InputError(f"cannot open the sample store {self.path}: {exc}") from exc
         try:
-            conn = self._conn
-            # WAL lets readers (a progress monitor, a second study) work while the run writes.
-            conn.execute("PRAGMA journal_mode = WAL")
-            # In WAL mode NORMAL loses no committed transaction when the *process* dies (only on power loss),
-            # and avoids an fsync per result.
-            conn.execute("PRAGMA synchronous = NORMAL")
-            with self._transaction():
-                version = conn.execute("PRAGMA user_version").fetchone()[0]
-                if version > _SCHEMA_VERSION:
-                    raise InputError(f"the sample store {self.path} was written by a newer mechopt (schema {version})")
-                conn.execute(_SCHEMA)
-                if version < _SCHEMA_VERSION:
-                    conn.execute(f"PRAGMA user_version = {_SCHEMA_VERSION}")
+            self._set_up(timeout)
         except sqlite3.DatabaseError as exc:
             self.close()
             raise InputError(f"{self.path} is not a usable sample store: {exc}") from exc
         except BaseException:
             self.close()
             raise
+
+    def _set_up(self, timeout: float) -> None:
+        """WAL mode and the schema, retried while another process is doing the same to a new file.
+
+        Switching a fresh database into WAL mode takes an exclusive lock and SQLite may report SQLITE_BUSY at once,
+        without waiting on the busy timeout, when two processes open the same new file together.
+        """
+        conn = self._c
+        deadline = time.monotonic() + timeout
+        delay = 0.005
+        while True:
+            try:
+                # WAL lets readers (a progress monitor, a second study) work while the run writes.
+                conn.execute("PRAGMA journal_mode = WAL")
+                # In WAL mode NORMAL loses no committed transaction when the *process* dies (only on power loss),
+                # and avoids an fsync per result.
+                conn.execute("PRAGMA synchronous = NORMAL")
+                with self._transaction():
+                    version = conn.execute("PRAGMA user_version").fetchone()[0]
+                    if version > _SCHEMA_VERSION:
+                        raise InputError(
+                            f"the sample store {self.path} was written by a newer mechopt (schema {version})"
+                        )
+                    conn.execute(_SCHEMA)
+                    if version < _SCHEMA_VERSION:
+                        conn.execute(f"PRAGMA user_version = {_SCHEMA_VERSION}")
+                return
+            except sqlite3.OperationalError as exc:
+                if "locked" not in str(exc) or time.monotonic() > deadline:
+                    raise
+                time.sleep(delay)
+                delay = min(2 * delay, 0.2)
 
     # -- plumbing -------------------------------------------------------------------------------------------
 

@@ -7,6 +7,7 @@ import sqlite3
 import subprocess
 import sys
 import textwrap
+import time
 from pathlib import Path
 
 import numpy as np
@@ -159,3 +160,31 @@ def test_two_processes_write_the_same_file(tmp_path):
     with SampleStore(path) as store:
         assert store.count(H1) == 3000
         assert sorted(r.oa for r in store.records(H1)) == [float(i) for i in range(3000)]
+
+
+def test_processes_opening_a_new_store_together_all_succeed(tmp_path):
+    """Six processes open the same *new* file at the same instant (the first run of parallel workers): switching a
+    fresh database to WAL can report 'database is locked' without waiting; the store retries instead of failing."""
+    script = tmp_path / "opener.py"
+    script.write_text(
+        textwrap.dedent(
+            f"""
+            import sys, time
+            sys.path.insert(0, {str(REPO)!r})
+            from studies.store import SampleStore
+            start = float(sys.argv[2])
+            while time.time() < start:
+                pass
+            with SampleStore(sys.argv[1]) as store:
+                print(store.count({H1!r}))
+            """
+        )
+    )
+    for trial in range(5):
+        path = tmp_path / f"new{trial}.sqlite"
+        start = time.time() + 1.5  # after every interpreter has started
+        procs = [subprocess.Popen([sys.executable, str(script), str(path), str(start)], stdout=subprocess.PIPE,
+                                  stderr=subprocess.PIPE, text=True) for _ in range(6)]
+        results = [p.communicate(timeout=60) for p in procs]
+        assert [p.returncode for p in procs] == [0] * 6, [err for _, err in results if err]
+        assert [out.strip() for out, _ in results] == ["0"] * 6
