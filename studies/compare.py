@@ -23,8 +23,8 @@ from surrogate.errors import SurrogateError
 
 from .baselines import BASELINES, CountedProblem, fit_and_search_rbf
 from .definition import Study
-from .design_space import DesignSpace
 from .ground_truth import GroundTruth
+from .run import make_space
 from .workflow import SurrogateOptions, optimize
 
 #: Bayesian optimisation refits a Gaussian process on all samples at every step (cubic cost): it is run up to this
@@ -122,8 +122,8 @@ class Run:
 def run_surrogate(study: Study, engine: str, budget: int, seed: int):
     """mechopt's pipeline within ``budget`` simulations; returns (design, calls, line samples)."""
     sampler = CountingSampler(study, engine)
-    space = DesignSpace(study.mechanism, study.region)
-    result = optimize(space, surrogate_options(budget, seed), sampler, log=lambda *_: None)
+    options = surrogate_options(budget, seed)
+    result = optimize(make_space(study, options), options, sampler, log=lambda *_: None)
     stage = result.stages[0]
     X = np.vstack(stage.line_designs)
     y = np.concatenate(stage.line_values)

@@ -21,6 +21,7 @@ import numpy as np
 
 from sim.feasibility import check_feasibility, constraint_margins
 from surrogate import LinePlan, SparseExponentialModel, exhaustive_search, plan_lines
+from surrogate.planner import LAYOUTS
 
 from .design_space import DesignSpace, from_u, to_u
 from .evaluate import Evaluator
@@ -107,8 +108,8 @@ class SurrogateOptions:
         opts = cls(**values)
         if opts.plan not in ("auto", "paper"):
             raise StudyError(f"key surrogate.plan = {opts.plan!r}; expected 'auto' or 'paper'")
-        if opts.layout not in ("fekete", "boundary"):
-            raise StudyError(f"key surrogate.layout = {opts.layout!r}; expected 'fekete' or 'boundary'")
+        if opts.layout not in LAYOUTS:
+            raise StudyError(f"key surrogate.layout = {opts.layout!r}; expected one of {', '.join(LAYOUTS)}")
         if opts.target not in TARGETS:
             raise StudyError(f"key surrogate.target = {opts.target!r}; expected one of {', '.join(TARGETS)}")
         for key in ("n_lines", "samples_per_line", "min_samples", "max_order", "search_points", "budget"):

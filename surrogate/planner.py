@@ -37,7 +37,8 @@ _SHRINKS = (0.9, 0.75, 0.6)
 _PHASES = (0.0, 0.5)
 _MIN_RUN = 4
 _RANK_POINTS = 4000
-_LAYOUTS = ("fekete", "boundary")
+#: Node layouts of :func:`plan_lines`.
+LAYOUTS = ("fekete", "boundary")
 #: Candidate nodes of the Fekete layout: hull vertices of the projected cloud, widened by these factors, and a
 #: subset of the projected points themselves.
 _WIDEN = (1.0, 1.05, 1.1)
@@ -354,8 +355,8 @@ def plan_lines(
     if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi)) and np.all(hi > lo)):
         raise SurrogateError(f"need finite bounds with upper > lower, got lower={lo.tolist()}, upper={hi.tolist()}")
     dim = lo.size
-    if layout not in _LAYOUTS:
-        raise SurrogateError(f"layout must be one of {', '.join(_LAYOUTS)}, got {layout!r}")
+    if layout not in LAYOUTS:
+        raise SurrogateError(f"layout must be one of {', '.join(LAYOUTS)}, got {layout!r}")
     if int(n_lines) < dim:
         raise SurrogateError(f"n_lines must be >= d = {dim} for the hull to have volume, got {n_lines}")
     if spacing is not None and not (np.isfinite(spacing) and spacing > 0):
