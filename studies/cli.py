@@ -14,9 +14,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-
-from sim.errors import InfeasibleDesignError, MechoptError
-from surrogate.errors import SurrogateError
+from mechopt.errors import InfeasibleDesignError, MechoptError
+from mechopt.surrogate.errors import SurrogateError
 
 if TYPE_CHECKING:
     from .workflow import SurrogateOptions
@@ -32,9 +31,9 @@ def _add_study(parser: argparse.ArgumentParser) -> None:
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
-    from sim.feasibility import check_feasibility
-    from sim.kinematics import check_design
-    from sim.simulate import simulate
+    from mechopt.sim.fourbar.feasibility import check_feasibility
+    from mechopt.sim.fourbar.kinematics import check_design
+    from mechopt.sim.fourbar.simulate import simulate
 
     from .definition import load_study
 
@@ -134,8 +133,8 @@ def _cmd_validate(args: argparse.Namespace) -> int:
 
 
 def _cmd_feasible(args: argparse.Namespace) -> int:
-    from sim.feasibility import check_feasibility
-    from surrogate import plan_lines
+    from mechopt.sim.fourbar.feasibility import check_feasibility
+    from mechopt.surrogate import plan_lines
 
     from .definition import load_study
     from .design_space import from_u, to_u

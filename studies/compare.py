@@ -14,12 +14,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-
-from sim.analytic import simulate_analytic
-from sim.errors import InfeasibleDesignError
-from sim.feasibility import check_feasibility, constraint_margins
-from sim.simulate import simulate
-from surrogate.errors import SurrogateError
+from mechopt.errors import InfeasibleDesignError
+from mechopt.sim.fourbar.analytic import simulate_analytic
+from mechopt.sim.fourbar.feasibility import check_feasibility, constraint_margins
+from mechopt.sim.fourbar.simulate import simulate
+from mechopt.surrogate.errors import SurrogateError
 
 from .baselines import BASELINES, CountedProblem, fit_and_search_rbf
 from .definition import Study
@@ -137,7 +136,7 @@ def compare(study: Study, truth: GroundTruth, budgets: list[int], seeds: int, en
     if methods:
         unknown = sorted(set(methods) - set(names))
         if unknown:
-            from sim.errors import InputError
+            from mechopt.errors import InputError
 
             raise InputError(f"unknown method {unknown[0]!r}; expected some of {', '.join(names)}")
         names = [n for n in names if n in methods]

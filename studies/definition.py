@@ -14,14 +14,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from mechopt.errors import MechoptError, StudyError
+from mechopt.sim.fourbar.kinematics import BRANCH_ADD, BRANCH_SUBTRACT
+from mechopt.sim.fourbar.load import RockerLoad
+from mechopt.sim.fourbar.mechanism import FourBar
+from mechopt.sim.fourbar.motion import LAW_CODES, MotionLaw
 
-from sim.errors import MechoptError, StudyError
-from sim.kinematics import BRANCH_ADD, BRANCH_SUBTRACT
-from sim.load import RockerLoad
-from sim.mechanism import FourBar
-from sim.motion import LAW_CODES, MotionLaw
-
-from .reconstruction import Reconstruction, read_motor_table, reconstruct
+from .ventilator.reconstruction import Reconstruction, read_motor_table, reconstruct
 
 STUDIES_DIR = Path(__file__).resolve().parent
 

@@ -15,9 +15,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-
-from sim.feasibility import check_feasibility
-from sim.mechanism import FourBar
+from mechopt.sim.fourbar.feasibility import check_feasibility
+from mechopt.sim.fourbar.mechanism import FourBar
 
 #: Index permutation design (oa, ab, bc) <-> paper coordinates U (oa, bc, ab); its own inverse.
 PAPER_ORDER = (0, 2, 1)

@@ -5,10 +5,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-
-from sim.errors import InputError
-from sim.mechanism import FourBar
-from sim.simulate import ENGINES, simulate
+from mechopt.errors import InputError
+from mechopt.sim.fourbar.mechanism import FourBar
+from mechopt.sim.fourbar.simulate import ENGINES, simulate
 
 from .store import settings_hash
 

@@ -30,7 +30,7 @@ from itertools import islice
 from typing import Any, TypeVar
 from urllib.parse import urlsplit
 
-from sim.errors import InputError, StudyError
+from mechopt.errors import InputError, StudyError
 
 __all__ = [
     "DaskExecutor",

@@ -15,10 +15,9 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
+from mechopt.sim.fourbar.analytic import analytic_batch
+from mechopt.sim.fourbar.feasibility import check_feasibility, constraint_margins
 from scipy.optimize import minimize
-
-from sim.analytic import analytic_batch
-from sim.feasibility import check_feasibility, constraint_margins
 
 from .definition import Study
 

@@ -9,9 +9,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-
-from sim.kinematics import joint_positions  # noqa: E402
-from sim.result import SimulationResult  # noqa: E402
+from mechopt.sim.fourbar.kinematics import joint_positions  # noqa: E402
+from mechopt.sim.fourbar.result import SimulationResult  # noqa: E402
 
 from .definition import Study  # noqa: E402
 
@@ -104,7 +103,7 @@ def plot_feasible_slices(study: Study, path: str | Path, oa_values: list[float] 
     n : int
         Grid resolution per axis.
     """
-    from sim.feasibility import check_feasibility
+    from mechopt.sim.fourbar.feasibility import check_feasibility
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -162,9 +161,8 @@ def plot_feasible_3d(study: Study, path: str | Path, lines: list[np.ndarray] | N
     n_points : int
         Random feasible designs shown as a cloud.
     """
+    from mechopt.sim.fourbar.feasibility import feasible_mask
     from scipy.spatial import ConvexHull
-
-    from sim.feasibility import feasible_mask
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)

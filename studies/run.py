@@ -14,8 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-
-from sim.simulate import simulate
+from mechopt.sim.fourbar.simulate import simulate
 
 from .definition import Study
 from .design_space import DesignSpace

@@ -20,9 +20,8 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from mechopt.errors import InfeasibleDesignError
 from tqdm.auto import tqdm
-
-from sim.errors import InfeasibleDesignError
 
 from .executors import SampleExecutor, make_executor
 from .store import SampleRecord, SampleStore, as_design, design_key

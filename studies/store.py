@@ -22,7 +22,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from sim.errors import InputError
+from mechopt.errors import InputError
 
 __all__ = [
     "KEY_DECIMALS",

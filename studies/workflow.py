@@ -18,10 +18,9 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
-
-from sim.feasibility import check_feasibility, constraint_margins
-from surrogate import LinePlan, SparseExponentialModel, exhaustive_search, plan_lines
-from surrogate.planner import LAYOUTS
+from mechopt.sim.fourbar.feasibility import check_feasibility, constraint_margins
+from mechopt.surrogate import LinePlan, SparseExponentialModel, exhaustive_search, plan_lines
+from mechopt.surrogate.planner import LAYOUTS
 
 from .design_space import DesignSpace, from_u, to_u
 from .evaluate import Evaluator
@@ -92,7 +91,7 @@ class SurrogateOptions:
     @classmethod
     def from_study(cls, section: dict, overrides: dict | None = None) -> SurrogateOptions:
         """Options from a study's ``[surrogate]`` section and CLI overrides; unknown keys are errors."""
-        from sim.errors import StudyError
+        from mechopt.errors import StudyError
 
         known = {f for f in cls.__dataclass_fields__}
         values = {}

@@ -11,7 +11,7 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 
 @pytest.fixture(scope="session")
 def ventilator():
-    from studies.definition import load_study
+    from mechopt.studies.definition import load_study
 
     return load_study("ventilator")
 

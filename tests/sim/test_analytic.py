@@ -4,9 +4,8 @@ import dataclasses
 
 import numpy as np
 import pytest
-
-from sim.analytic import analytic_batch, simulate_analytic, torque_curve
-from sim.kinematics import crank_angle, joint_positions
+from mechopt.sim.fourbar.analytic import analytic_batch, simulate_analytic, torque_curve
+from mechopt.sim.fourbar.kinematics import crank_angle, joint_positions
 
 
 def _energy(design_mm, mech, t):

@@ -2,14 +2,13 @@
 
 import numpy as np
 import pytest
+from mechopt.errors import InfeasibleDesignError
+from mechopt.sim.fourbar.feasibility import check_feasibility, feasible_mask, require_movable
+from mechopt.sim.fourbar.kinematics import crank_angle
+from mechopt.sim.fourbar.load import RockerLoad
+from mechopt.sim.fourbar.mechanism import FourBar
+from mechopt.sim.fourbar.motion import MotionLaw
 from scipy.optimize import brentq
-
-from sim.errors import InfeasibleDesignError
-from sim.feasibility import check_feasibility, feasible_mask, require_movable
-from sim.kinematics import crank_angle
-from sim.load import RockerLoad
-from sim.mechanism import FourBar
-from sim.motion import MotionLaw
 
 
 def _straddle(mechanism, column, base, index, lo, hi):

@@ -2,10 +2,9 @@
 
 import numpy as np
 import pytest
-
-from sim.errors import InputError
-from sim.kinematics import check_design, crank_angle, joint_positions, rocker_angle
-from sim.pymunk_sim import simulate_pymunk
+from mechopt.errors import InputError
+from mechopt.sim.fourbar.kinematics import check_design, crank_angle, joint_positions, rocker_angle
+from mechopt.sim.fourbar.pymunk_engine import simulate_pymunk
 
 
 def test_parallelogram_by_hand():

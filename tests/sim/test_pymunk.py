@@ -2,12 +2,11 @@
 
 import numpy as np
 import pytest
+from mechopt.sim.fourbar.analytic import MM, simulate_analytic, torque_curve
+from mechopt.sim.fourbar.feasibility import check_feasibility
+from mechopt.sim.fourbar.kinematics import crank_angle
+from mechopt.sim.fourbar.pymunk_engine import _run, simulate_pymunk
 from scipy.optimize import brentq
-
-from sim.analytic import MM, simulate_analytic, torque_curve
-from sim.feasibility import check_feasibility
-from sim.kinematics import crank_angle
-from sim.pymunk_sim import _run, simulate_pymunk
 
 
 def _boundary_design(mechanism, base, distance_mm):

@@ -5,8 +5,7 @@ import subprocess
 import sys
 
 import pytest
-
-from studies.cli import EXIT_ERROR, EXIT_INFEASIBLE, main
+from mechopt.studies.cli import EXIT_ERROR, EXIT_INFEASIBLE, main
 
 
 def test_simulate_prints_feasibility_and_torques(capsys):
@@ -86,7 +85,7 @@ def test_explicit_study_file(tmp_path, capsys):
 
 def test_console_script_without_traceback():
     proc = subprocess.run(
-        [sys.executable, "-m", "studies.cli", "simulate", "--oa", "-1", "--ab", "65", "--bc", "282"],
+        [sys.executable, "-m", "mechopt.studies.cli", "simulate", "--oa", "-1", "--ab", "65", "--bc", "282"],
         capture_output=True, text=True, check=False,
     )
     assert proc.returncode == EXIT_ERROR

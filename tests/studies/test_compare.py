@@ -4,8 +4,7 @@ import json
 
 import numpy as np
 import pytest
-
-from studies.cli import EXIT_ERROR, main
+from mechopt.studies.cli import EXIT_ERROR, main
 
 
 def test_compare_small(tmp_path, capsys):

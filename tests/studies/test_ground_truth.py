@@ -4,11 +4,10 @@ import json
 
 import numpy as np
 import pytest
-
-from sim.analytic import analytic_batch
-from sim.feasibility import check_feasibility
-from sim.pymunk_sim import simulate_pymunk
-from studies.ground_truth import compute_ground_truth, load_or_compute
+from mechopt.sim.fourbar.analytic import analytic_batch
+from mechopt.sim.fourbar.feasibility import check_feasibility
+from mechopt.sim.fourbar.pymunk_engine import simulate_pymunk
+from mechopt.studies.ground_truth import compute_ground_truth, load_or_compute
 
 
 @pytest.fixture(scope="module")

@@ -2,9 +2,8 @@
 
 import numpy as np
 import pytest
-
-from sim.analytic import simulate_analytic
-from sim.pymunk_sim import simulate_pymunk
+from mechopt.sim.fourbar.analytic import simulate_analytic
+from mechopt.sim.fourbar.pymunk_engine import simulate_pymunk
 
 
 def test_reconstruction_matches_the_data_readme(ventilator):
@@ -25,8 +24,8 @@ def test_reconstruction_matches_the_data_readme(ventilator):
 
 
 def test_reconstructed_inertia_reproduces_the_table(ventilator):
-    from sim.kinematics import rocker_angle
-    from studies.reconstruction import read_motor_table
+    from mechopt.sim.fourbar.kinematics import rocker_angle
+    from mechopt.studies.ventilator.reconstruction import read_motor_table
 
     rec = ventilator.reconstruction
     table = read_motor_table(ventilator.path.parent / "original_design_load_inertia.csv")

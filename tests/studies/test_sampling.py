@@ -13,11 +13,10 @@ from collections import Counter
 from pathlib import Path
 
 import pytest
-
-from sim.errors import InputError
-from studies.executors import InProcessExecutor, ProcessExecutor, make_executor
-from studies.sampling import sample_designs
-from studies.store import SampleStore, design_key, settings_hash
+from mechopt.errors import InputError
+from mechopt.studies.executors import InProcessExecutor, ProcessExecutor, make_executor
+from mechopt.studies.sampling import sample_designs
+from mechopt.studies.store import SampleStore, design_key, settings_hash
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parents[1]
@@ -215,9 +214,9 @@ import sys
 sys.path[:0] = [{repo!r}, {here!r}]
 
 import toy_eval
-from studies.executors import make_executor
-from studies.sampling import sample_designs
-from studies.store import SampleStore
+from mechopt.studies.executors import make_executor
+from mechopt.studies.sampling import sample_designs
+from mechopt.studies.store import SampleStore
 
 
 def main():

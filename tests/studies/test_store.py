@@ -12,9 +12,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from sim.errors import InputError
-from studies.store import SampleRecord, SampleStore, design_key, settings_hash
+from mechopt.errors import InputError
+from mechopt.studies.store import SampleRecord, SampleStore, design_key, settings_hash
 
 REPO = Path(__file__).resolve().parents[2]
 H1 = settings_hash({"engine": "analytic", "rpm": 20})
@@ -138,7 +137,7 @@ def test_two_processes_write_the_same_file(tmp_path):
             f"""
             import sys
             sys.path.insert(0, {str(REPO)!r})
-            from studies.store import SampleRecord, SampleStore
+            from mechopt.studies.store import SampleRecord, SampleStore
             lo, hi = int(sys.argv[1]), int(sys.argv[2])
             inserted = 0
             with SampleStore({str(path)!r}) as store:
@@ -171,7 +170,7 @@ def test_processes_opening_a_new_store_together_all_succeed(tmp_path):
             f"""
             import sys, time
             sys.path.insert(0, {str(REPO)!r})
-            from studies.store import SampleStore
+            from mechopt.studies.store import SampleStore
             start = float(sys.argv[2])
             while time.time() < start:
                 pass

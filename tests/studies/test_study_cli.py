@@ -5,8 +5,7 @@ import re
 
 import numpy as np
 import pytest
-
-from studies.cli import EXIT_ERROR, main
+from mechopt.studies.cli import EXIT_ERROR, main
 
 SMALL = ["--engine", "analytic", "--workers", "1", "--no-progress", "--samples-per-line", "24",
          "--search-points", "200000", "--points-per-line", "8"]
@@ -47,9 +46,9 @@ def test_study_writes_result_report_and_figures(study_dir):
 
 
 def test_rerun_resumes_from_the_store(study_dir, tmp_path, capsys):
-    from studies.definition import load_study
-    from studies.evaluate import Evaluator
-    from studies.store import SampleStore
+    from mechopt.studies.definition import load_study
+    from mechopt.studies.evaluate import Evaluator
+    from mechopt.studies.store import SampleStore
 
     study = load_study("ventilator")
     key = Evaluator(study.mechanism, "analytic", study.name).settings_hash()
@@ -90,7 +89,7 @@ def test_feasible_plots(tmp_path, capsys):
     ],
 )
 def test_bad_study_keys(tmp_path, capsys, section, expected):
-    from studies.definition import STUDIES_DIR
+    from mechopt.studies.definition import STUDIES_DIR
 
     text = (STUDIES_DIR / "ventilator" / "study.toml").read_text()
     (tmp_path / "original_design_load_inertia.csv").write_text(
@@ -106,9 +105,9 @@ def test_bad_study_keys(tmp_path, capsys, section, expected):
 
 
 def test_paper_plan_is_expressible():
-    from studies.definition import load_study
-    from studies.design_space import DesignSpace
-    from studies.workflow import SurrogateOptions, _paper_plan
+    from mechopt.studies.definition import load_study
+    from mechopt.studies.design_space import DesignSpace
+    from mechopt.studies.workflow import SurrogateOptions, _paper_plan
 
     study = load_study("ventilator")
     opts = SurrogateOptions(plan="paper", samples_per_line=30, min_samples=10)

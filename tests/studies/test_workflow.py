@@ -2,11 +2,10 @@
 budget, and the reported optimum is the best *simulated* design."""
 
 import numpy as np
-
-from studies.compare import CountingSampler
-from studies.definition import load_study
-from studies.design_space import DesignSpace
-from studies.workflow import SurrogateOptions, optimize
+from mechopt.studies.compare import CountingSampler
+from mechopt.studies.definition import load_study
+from mechopt.studies.design_space import DesignSpace
+from mechopt.studies.workflow import SurrogateOptions, optimize
 
 
 def test_refinement_improves_on_the_model_candidate_within_the_budget():

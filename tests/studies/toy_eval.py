@@ -10,9 +10,8 @@ import os
 import time
 
 import numpy as np
-
-from sim.errors import InfeasibleDesignError
-from studies.store import design_key
+from mechopt.errors import InfeasibleDesignError
+from mechopt.studies.store import design_key
 
 #: A design with this |OA| (mm) makes :func:`toy_eval` raise a plain error.
 FAIL_OA = 13.0

@@ -4,8 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
-from surrogate import ChebyshevBlend, SurrogateError
+from mechopt.surrogate import ChebyshevBlend, SurrogateError
 
 
 @pytest.mark.parametrize("l", [1, 2, 3, 4, 5, 6, 7, 10, 15])

@@ -4,8 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
-from surrogate import LinePlan, SparseExponentialModel, SurrogateError, SurrogateWarning
+from mechopt.surrogate import LinePlan, SparseExponentialModel, SurrogateError, SurrogateWarning
 
 PAPER_DELTA = np.array([0.000, 0.920, 0.503])
 PAPER_ORIGIN = np.array([31.000, 257.859, 72.705])

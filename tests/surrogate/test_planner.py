@@ -6,8 +6,7 @@ import time
 
 import numpy as np
 import pytest
-
-from surrogate import LinePlan, SurrogateError, coverage, plan_lines
+from mechopt.surrogate import LinePlan, SurrogateError, coverage, plan_lines
 
 
 def cell_centres(n):
@@ -97,7 +96,7 @@ def test_empty_feasible_region_is_reported():
 def test_fekete_points_in_one_dimension_are_close_to_gauss_lobatto():
     # The Fekete points of degree-4 polynomials on [-1, 1] are the Gauss-Lobatto nodes 0, ±sqrt(3/7), ±1; the
     # greedy (approximate) ones chosen from a 0.01 grid land within 0.03 of them.
-    from surrogate.planner import fekete_points
+    from mechopt.surrogate.planner import fekete_points
 
     x = np.linspace(-1.0, 1.0, 201)[:, None]
     chosen = np.sort(x[fekete_points(x, 5)].ravel())
@@ -109,7 +108,7 @@ def test_fekete_layout_keeps_the_blend_well_conditioned_where_the_boundary_layou
     # 15 lines (a quartic blend) over a box region: the Lebesgue constant of the blend over the hull, max Σ|L_i|,
     # bounds how much line errors are amplified.  Fekete nodes keep it near that of the square's own Fekete points
     # (~5); nodes on the outline plus the centroid leave a quartic nearly undetermined inside (> 30).
-    from surrogate.blending import ChebyshevBlend
+    from mechopt.surrogate.blending import ChebyshevBlend
 
     lo, hi = np.array([0.2, 0.1, 0.3]), np.array([0.8, 0.6, 0.9])
 

@@ -18,7 +18,7 @@ import numpy as np
 if __package__ in (None, ""):
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from surrogate import LinePlan, SparseExponentialModel, exhaustive_search, grid_minimum, hull_grid  # noqa: E402
+from mechopt.surrogate import LinePlan, SparseExponentialModel, exhaustive_search, grid_minimum, hull_grid  # noqa: E402
 
 PAPER_DELTA = np.array([0.000, 0.920, 0.503])  # the paper's Δ in U = (|OA|, |BC|, |AB|) coordinates, mm
 PAPER_ORIGIN = np.array([31.000, 257.859, 72.705])

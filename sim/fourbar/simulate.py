@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import numpy as np
+from mechopt.errors import InputError
 
 from .analytic import simulate_analytic
-from .errors import InputError
 from .mechanism import FourBar
-from .pymunk_sim import simulate_pymunk
+from .pymunk_engine import simulate_pymunk
 from .result import SimulationResult
 
 ENGINES = ("pymunk", "analytic")

@@ -1,7 +1,7 @@
 """Brute-force benchmark study: the ventilator's true optimum by a dense grid of the analytic engine.
 
-Run: ``python -m studies.bench_bruteforce [--steps 2,1,0.5]``.  For each grid spacing it prints the designs evaluated,
-the best grid point, the polished optimum and the time; numba is warmed up first.
+Run: ``python -m benchmarks.bench_bruteforce [--steps 2,1,0.5]``.  For each grid spacing it prints the designs
+evaluated, the best grid point, the polished optimum and the time; numba is warmed up first.
 """
 
 from __future__ import annotations
@@ -10,10 +10,9 @@ import argparse
 import os
 import time
 
-from sim.analytic import analytic_batch
-
-from .definition import load_study
-from .ground_truth import compute_ground_truth
+from mechopt.sim.fourbar.analytic import analytic_batch
+from mechopt.studies.definition import load_study
+from mechopt.studies.ground_truth import compute_ground_truth
 
 
 def main() -> None:
@@ -48,10 +47,8 @@ def basin_check(study, n_starts: int, seed: int = 5) -> str:
     from collections import Counter
 
     import numpy as np
-
-    from sim.feasibility import feasible_mask
-
-    from .ground_truth import polish
+    from mechopt.sim.fourbar.feasibility import feasible_mask
+    from mechopt.studies.ground_truth import polish
 
     rng = np.random.default_rng(seed)
     starts = rng.uniform(study.region[:, 0], study.region[:, 1], size=(100 * n_starts, 3))

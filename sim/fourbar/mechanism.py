@@ -10,8 +10,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from mechopt.errors import InputError
 
-from .errors import InputError
 from .kinematics import BRANCH_SUBTRACT, validate_pivot
 from .load import RockerLoad
 from .motion import MotionLaw

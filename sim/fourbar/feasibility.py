@@ -19,9 +19,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from mechopt.errors import InfeasibleDesignError, InputError
 from numba import njit, prange
 
-from .errors import InfeasibleDesignError, InputError
 from .kinematics import _crank_kernel
 from .mechanism import FourBar
 

@@ -1,6 +1,7 @@
 """Benchmark of the simulation engines (issue 2): pymunk and analytic time per design, batch throughput.
 
-Run: ``python -m studies.bench_simulation [--designs 100] [--repeats 5]``.  Prints a Markdown table for BENCHMARKS.md.
+Run: ``python -m benchmarks.bench_simulation [--designs 100] [--repeats 5]``.  Prints a Markdown table for
+BENCHMARKS.md.
 numba functions are compiled (warm-up) before anything is timed.
 """
 
@@ -12,12 +13,10 @@ import platform
 import time
 
 import numpy as np
-
-from sim.analytic import analytic_batch, simulate_analytic
-from sim.feasibility import feasible_mask
-from sim.pymunk_sim import simulate_pymunk
-
-from .definition import load_study
+from mechopt.sim.fourbar.analytic import analytic_batch, simulate_analytic
+from mechopt.sim.fourbar.feasibility import feasible_mask
+from mechopt.sim.fourbar.pymunk_engine import simulate_pymunk
+from mechopt.studies.definition import load_study
 
 
 def main() -> None:

@@ -14,11 +14,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from mechopt.errors import StudyError
+from mechopt.sim.fourbar.kinematics import crank_angle, rocker_angle
+from mechopt.sim.fourbar.load import RockerLoad
 from scipy.optimize import least_squares
-
-from sim.errors import StudyError
-from sim.kinematics import crank_angle, rocker_angle
-from sim.load import RockerLoad
 
 
 @dataclass(frozen=True)

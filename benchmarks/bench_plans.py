@@ -1,6 +1,6 @@
 """Benchmark of line plans: held-out accuracy of the global model for the paper's plan and for mechopt's.
 
-Run with ``python -m studies.bench_plans [--seeds 5] [--engine analytic]``.  Every configuration samples its lines,
+Run with ``python -m benchmarks.bench_plans [--seeds 5] [--engine analytic]``.  Every configuration samples its lines,
 fits and blends them, and is scored on 10 held-out lines of 30 points inside its hull (the study's validation), with
 the analytic engine by default (the pymunk engine gives the same figures to ~1e-4 and takes 15 times longer).  Prints a
 Markdown table: samples on the lines, coverage of the feasible region, held-out RMSE in N·m and in per cent of the
@@ -16,12 +16,11 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-
-from .definition import load_study
-from .design_space import to_u
-from .ground_truth import load_or_compute
-from .run import make_space, open_sampler
-from .workflow import SurrogateOptions, build_stage, validate
+from mechopt.studies.definition import load_study
+from mechopt.studies.design_space import to_u
+from mechopt.studies.ground_truth import load_or_compute
+from mechopt.studies.run import make_space, open_sampler
+from mechopt.studies.workflow import SurrogateOptions, build_stage, validate
 
 #: (label, options changed from the study's defaults)
 CONFIGS = [
