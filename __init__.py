@@ -2,7 +2,19 @@
 
 The method is that of Ben Yahya et al. (2023, paper 002): simulate designs, bound the design space by feasibility,
 sample the objective on parallel lines, fit each line with a sum of exponentials, blend the line models by Chebyshev
-interpolation, search the blend exhaustively and validate on held-out simulations.
+interpolation, search the blend exhaustively, refine on the simulator and validate on held-out simulations.
+
+Public API (flat, as scipy.optimize and pymunk):
+
+- :class:`DesignProblem`, :class:`Variable` — declare a problem: variables, constraint margins, evaluator, objective;
+- :func:`minimize` -> :class:`OptimizeResult` — the sparse method or any baseline, within a simulation budget;
+- :func:`load_study`, :func:`available_studies` — the studies shipped with mechopt (and yours, as TOML files);
+- :class:`SparseOptions` — the sparse method's declared options (``SparseOptions.help()``);
+- :class:`SampleStore` — the resumable SQLite store of simulated designs;
+- :class:`ObjectiveModel` — a fitted sparse model (``.predict``, ``.save``, ``.load``);
+- :func:`register_mechanism` — add a mechanism kind for study files;
+- errors: :class:`MechoptError` and its subclasses :class:`InputError`, :class:`StudyError`,
+  :class:`InfeasibleDesignError`.
 
 Subpackages: :mod:`mechopt.sim` (the physics: one folder per mechanism), :mod:`mechopt.surrogate` (the mathematics,
 independent of the physics) and :mod:`mechopt.studies` (the engine that runs a study, and the shipped studies).
@@ -14,4 +26,35 @@ use_user_cache()
 
 from .errors import InfeasibleDesignError, InputError, MechoptError, StudyError  # noqa: E402
 
-__all__ = ["InfeasibleDesignError", "InputError", "MechoptError", "StudyError"]
+__version__ = "0.2.0"
+
+# The rest of the API is imported on first use (PEP 562): every worker process and every CLI call imports mechopt,
+# and the optimizers behind minimize() (scipy.stats, the baselines) cost seconds that a simulation does not need.
+_LAZY = {
+    "DesignProblem": "mechopt.studies.problem",
+    "Variable": "mechopt.studies.problem",
+    "minimize": "mechopt.studies.minimize",
+    "OptimizeResult": "mechopt.studies.result",
+    "load_study": "mechopt.studies.definition",
+    "available_studies": "mechopt.studies.definition",
+    "SparseOptions": "mechopt.studies.sparse.options",
+    "ObjectiveModel": "mechopt.studies.sparse.model",
+    "SampleStore": "mechopt.studies.store",
+    "register_mechanism": "mechopt.sim.registry",
+}
+
+__all__ = sorted(["InfeasibleDesignError", "InputError", "MechoptError", "StudyError", *_LAZY])
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'mechopt' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

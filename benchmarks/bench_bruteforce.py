@@ -22,16 +22,16 @@ def main() -> None:
     parser.add_argument("--study", default="ventilator")
     parser.add_argument("--starts", type=int, default=30, help="random feasible starts of the basin check")
     args = parser.parse_args()
-    study = load_study(args.study)
-    analytic_batch(study.region[:, 0][None, :] + 1.0, study.mechanism)  # warm-up
-    print(f"study {study.name}, region {study.region.tolist()} mm, {os.cpu_count()} cores")
+    study = load_study(args.study, {"engine": "analytic"})
+    analytic_batch(study.problem.bounds[:, 0][None, :] + 1.0, study.problem.mechanism)  # warm-up
+    print(f"study {study.name}, region {study.problem.bounds.tolist()} mm, {os.cpu_count()} cores")
     print()
     print("| grid (mm) | designs | feasible | best grid design (mm) | T_RMS grid (N·m) | polished optimum (mm) "
           "| T_RMS (N·m) | designs/s | time (s) |")
     print("|---|---|---|---|---|---|---|---|---|")
     for step in (float(s) for s in args.steps.split(",")):
         t0 = time.perf_counter()
-        g = compute_ground_truth(study, step)
+        g = compute_ground_truth(study.problem, step)
         wall = time.perf_counter() - t0
         fmt = lambda v: "(" + ", ".join(f"{c:.3f}" for c in v) + ")"  # noqa: E731
         print(f"| {step:g} | {g.n_evaluated:,} | {g.n_feasible:,} | {fmt(g.grid_x)} | {g.grid_fun:.5f} | "
@@ -47,13 +47,15 @@ def basin_check(study, n_starts: int, seed: int = 5) -> str:
     from collections import Counter
 
     import numpy as np
+
     from mechopt.sim.fourbar.feasibility import feasible_mask
     from mechopt.studies.ground_truth import polish
 
     rng = np.random.default_rng(seed)
-    starts = rng.uniform(study.region[:, 0], study.region[:, 1], size=(100 * n_starts, 3))
-    starts = starts[feasible_mask(starts, study.mechanism)][:n_starts]
-    ends = Counter(round(polish(study, x0)[1], 4) for x0 in starts)
+    box = study.problem.bounds
+    starts = rng.uniform(box[:, 0], box[:, 1], size=(100 * n_starts, 3))
+    starts = starts[feasible_mask(starts, study.problem.mechanism)][:n_starts]
+    ends = Counter(round(polish(study.problem, x0)[1], 4) for x0 in starts)
     found = ", ".join(f"{f:.4f} N·m ×{n}" for f, n in sorted(ends.items()))
     return f"basin check: SLSQP from {len(starts)} random feasible starts ends at {found}"
 

@@ -16,29 +16,33 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-from mechopt.studies.definition import load_study
-from mechopt.studies.design_space import to_u
-from mechopt.studies.ground_truth import load_or_compute
-from mechopt.studies.run import make_space, open_sampler
-from mechopt.studies.workflow import SurrogateOptions, build_stage, validate
 
-#: (label, options changed from the study's defaults)
+from mechopt.studies.definition import load_study
+from mechopt.studies.ground_truth import load_or_compute
+from mechopt.studies.run import study_options
+from mechopt.studies.sparse.sampler import Sampler
+from mechopt.studies.sparse.space import ModelSpace
+from mechopt.studies.sparse.stage import build_stage
+from mechopt.studies.sparse.validate import validate
+from mechopt.studies.store import SampleStore
+
+#: (label, options changed from the study's defaults, the toggle relaxation of the lines in degrees)
 CONFIGS = [
-    ("the paper's: 7 lines, its Δ, spacing and origin, T_RMS fitted", dict(plan="paper", target="rms")),
+    ("the paper's: 7 lines, its Δ, spacing and origin, T_RMS fitted", dict(plan="paper", fit="value"), 5.0),
     ("7 lines on the region's outline, T_RMS fitted", dict(n_lines=7, samples_per_line=40, min_samples=24,
-                                                            layout="boundary", target="rms", toggle_relax_deg=10.0)),
+                                                            layout="boundary", fit="value"), 10.0),
     ("7 lines on the region's outline, T_RMS² fitted", dict(n_lines=7, samples_per_line=40, min_samples=24,
-                                                             layout="boundary", toggle_relax_deg=10.0)),
-    ("21 lines on the region's outline, T_RMS² fitted", dict(layout="boundary")),
-    ("21 lines at Fekete nodes, T_RMS fitted", dict(target="rms")),
-    ("21 lines at Fekete nodes, T_RMS² fitted (default)", dict()),
+                                                             layout="boundary"), 10.0),
+    ("21 lines on the region's outline, T_RMS² fitted", dict(layout="boundary"), 5.0),
+    ("21 lines at Fekete nodes, T_RMS fitted", dict(fit="value"), 5.0),
+    ("21 lines at Fekete nodes, T_RMS² fitted (default)", dict(), 5.0),
 ]
 
 
 def lebesgue_constant(model, designs: np.ndarray) -> float:
     """max Σ|L_i| of the blend over the designs (mm)."""
-    P = model.plan.normal_coordinates(to_u(designs))
-    return float(np.abs(model.blend.lagrange(P)).sum(axis=1).max())
+    P = model.plan.normal_coordinates(model.to_u(designs))
+    return float(np.abs(model.model.blend.lagrange(P)).sum(axis=1).max())
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -47,28 +51,28 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--seeds", type=int, default=5, help="seeds of the planner and the validation lines")
     parser.add_argument("--engine", choices=("analytic", "pymunk"), default="analytic")
     args = parser.parse_args(argv)
-    study = load_study("ventilator")
-    base = SurrogateOptions.from_study(study.section("surrogate"))
+    study = load_study("ventilator", {"engine": args.engine})
+    base = study_options(study)
     with tempfile.TemporaryDirectory() as tmp:
-        truth = load_or_compute(study, Path(tmp) / "truth.json", 1.0)
+        truth = load_or_compute(study.problem, Path(tmp) / "truth.json", 1.0)
         print(f"study ventilator, {args.engine} engine, T_min {truth.fun:.4f} N·m (ground truth); "
               f"seeds 0..{args.seeds - 1}; 10 held-out lines x 30 points\n")
         print("| plan | samples (median) | coverage (median) | held-out RMSE (N·m), median | % of T_min: median "
               "(min–max) | Lebesgue constant (median) |")
         print("|---|---|---|---|---|---|")
-        for label, changes in CONFIGS:
+        for label, changes, relax in CONFIGS:
             rows = []
+            space = ModelSpace(replace(study.problem, toggle_relax_deg=relax))
             for seed in range(args.seeds):
-                options = replace(base, **changes, seed=seed, search_points=200_000)
-                space = make_space(study, options)
-                store, _, sampler = open_sampler(study, args.engine, Path(tmp) / f"s{seed}.sqlite", 1, None, False)
-                with store:
+                options = base.replace(**changes, seed=seed, search_points=200_000)
+                with SampleStore(Path(tmp) / f"s{seed}.sqlite") as store:
+                    sampler = Sampler(space.problem, store, progress=False)
                     stage = build_stage("global", space, options, sampler, options.n_lines,
                                         options.samples_per_line, options.search_points,
                                         paper=options.plan == "paper", max_samples=options.budget - 1)
                     val = validate(stage.model, space, sampler, options.validation_lines,
-                                   options.validation_points, seed, t_min=truth.fun)
-                designs = np.vstack([np.asarray(line["designs_mm"]) for line in val.lines])
+                                   options.validation_points, seed, f_min=truth.fun)
+                designs = np.vstack([np.asarray(line["designs"]) for line in val.lines])
                 rows.append((stage.n_samples, stage.coverage, val.rmse, lebesgue_constant(stage.model, designs)))
             r = np.array(rows)
             pct = 100 * r[:, 2] / truth.fun

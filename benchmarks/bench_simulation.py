@@ -13,6 +13,7 @@ import platform
 import time
 
 import numpy as np
+
 from mechopt.sim.fourbar.analytic import analytic_batch, simulate_analytic
 from mechopt.sim.fourbar.feasibility import feasible_mask
 from mechopt.sim.fourbar.pymunk_engine import simulate_pymunk
@@ -28,9 +29,10 @@ def main() -> None:
     args = parser.parse_args()
 
     study = load_study("ventilator")
-    mech = study.mechanism
+    mech = study.problem.mechanism
+    region = study.problem.bounds
     rng = np.random.default_rng(0)
-    cloud = rng.uniform(study.region[:, 0], study.region[:, 1], size=(20 * args.designs, 3))
+    cloud = rng.uniform(region[:, 0], region[:, 1], size=(20 * args.designs, 3))
     designs = cloud[feasible_mask(cloud, mech)][: args.designs]
 
     simulate_analytic(designs[0], mech)  # warm-up: numba compile / cache load
@@ -51,7 +53,7 @@ def main() -> None:
         simulate_analytic(d, mech)
         ana.append(time.perf_counter() - t0)
 
-    batch = rng.uniform(study.region[:, 0], study.region[:, 1], size=(args.batch, 3))
+    batch = rng.uniform(region[:, 0], region[:, 1], size=(args.batch, 3))
     times_nocheck, times_check = [], []
     for _ in range(args.repeats):
         t0 = time.perf_counter()

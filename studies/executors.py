@@ -157,7 +157,13 @@ def _mp_context() -> multiprocessing.context.BaseContext:
     # Not "fork": the parent may hold threads (tqdm monitor, a Dask client) and an SQLite connection, neither
     # of which survives fork() safely.  forkserver is the Python 3.14 default on POSIX; spawn elsewhere.
     methods = multiprocessing.get_all_start_methods()
-    return multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
+    if "forkserver" not in methods:
+        return multiprocessing.get_context("spawn")
+    context = multiprocessing.get_context("forkserver")
+    # The server imports mechopt (numpy, scipy...) once and forks every worker from it, instead of each worker
+    # importing it anew (seconds per worker).  Only the first start of the server reads this list.
+    context.set_forkserver_preload(["__main__", "mechopt.studies.sampling"])
+    return context
 
 
 class ProcessExecutor(SampleExecutor):

@@ -1,172 +1,162 @@
-"""Ground truth: the true optimum of a study by dense brute force of the analytic engine, then a local polish.
+"""Ground truth: a problem's true optimum by dense brute force of a fast batch evaluator, then a local polish.
 
-The paper could not know its true optimum (10 million CAD runs); with the analytic engine (numba, ~10⁵ designs/s) a
-dense grid over the whole region is affordable.  The grid's best feasible design is refined on a finer local grid and
-polished by SLSQP with the feasibility margins as inequality constraints.  The result is cached in a JSON file keyed
-by the study's settings, so comparisons do not recompute it.
+The paper could not know its true optimum (10 million CAD runs).  A problem that offers ``evaluate_batch`` (the
+four-bar's analytic engine: ~10⁵ designs/s) can afford a dense grid over its whole region: the grid's best feasible
+design is refined on a finer local grid and polished by SLSQP with the margins as constraints.  The result is
+cached in a JSON file keyed by the problem's fingerprint and the grid, so comparisons do not recompute it.  Opt-in:
+``mechopt truth`` or ``mechopt study --truth``.
 """
 
 from __future__ import annotations
 
-import hashlib
 import json
 import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
-from mechopt.sim.fourbar.analytic import analytic_batch
-from mechopt.sim.fourbar.feasibility import check_feasibility, constraint_margins
 from scipy.optimize import minimize
 
-from .definition import Study
+from mechopt.errors import InputError, MechoptError
+
+from .fingerprint import fingerprint
+from .problem import DesignProblem
+from .sparse.feasible_point import pull_into_feasible
+from .sparse.space import ModelSpace
+
+__all__ = ["GroundTruth", "compute_ground_truth", "load_or_compute"]
 
 
 @dataclass
 class GroundTruth:
-    """The true optimum of a study over its region.
+    """The true optimum of a problem over its region.
 
     Attributes
     ----------
     x : list of float
-        Optimal design (|OA|, |AB|, |BC|) in mm.
+        Optimal design, in the variables' units.
     fun : float
-        Its T_RMS (N·m), analytic engine.
+        Its objective by the batch evaluator.
     grid_x, grid_fun : list of float, float
-        Best point of the coarse grid and its T_RMS.
-    step_mm : float
-        Spacing of the coarse grid (mm).
+        Best point of the coarse grid and its objective.
+    step : float
+        Spacing of the coarse grid (the variables' unit).
     n_evaluated, n_feasible : int
         Designs on the coarse grid, and how many of them are feasible.
-    margins : dict
-        Constraint margins at ``x``.
     wall_time_s : float
         Time to compute it (s).
     key : str
-        Hash of the study settings it belongs to.
+        Hash of the problem's fingerprint and the grid.
     """
 
     x: list[float]
     fun: float
     grid_x: list[float]
     grid_fun: float
-    step_mm: float
+    step: float
     n_evaluated: int
     n_feasible: int
-    margins: dict
     wall_time_s: float
     key: str
 
 
-def study_key(study: Study, step_mm: float) -> str:
-    """Hash of everything the ground truth depends on: the study file, its data and the grid step."""
-    h = hashlib.sha256(study.path.read_bytes())
-    m = study.mechanism
-    h.update(json.dumps([m.pivot_c, m.j0, m.i_r, m.psi_start, m.psi_end, step_mm]).encode())
-    return h.hexdigest()[:16]
+def truth_key(problem: DesignProblem, step: float) -> str:
+    """Hash of everything the ground truth depends on."""
+    return fingerprint({"problem": problem.fingerprint(), "bounds": problem.bounds.tolist(), "step": step})[:16]
 
 
-def evaluate_grid(study: Study, axes: list[np.ndarray], chunk: int = 400_000) -> tuple[np.ndarray, float, int, int]:
-    """Best feasible design on the tensor grid ``axes`` (mm), its T_RMS, the designs evaluated and feasible."""
-    mesh = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+def _batch(problem: DesignProblem):
+    fn = getattr(problem, "evaluate_batch", None)
+    if fn is None:
+        raise MechoptError(f"problem {problem.name!r} has no fast batch evaluator (evaluate_batch); its ground truth "
+                           "cannot be brute-forced here")
+    return fn
+
+
+def evaluate_grid(problem: DesignProblem, axes: list[np.ndarray], chunk: int = 400_000):
+    """Best feasible design on the tensor grid ``axes``, its objective, the designs evaluated and feasible."""
+    batch = _batch(problem)
+    mesh = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, len(axes))
     best_x, best_f, n_feasible = None, np.inf, 0
     for lo in range(0, mesh.shape[0], chunk):
         block = mesh[lo : lo + chunk]
-        ok = check_feasibility(block, study.mechanism).feasible
+        ok = problem.feasible(block)
         n_feasible += int(ok.sum())
         if not ok.any():
             continue
-        t_rms, _ = analytic_batch(block[ok], study.mechanism, check=False)
-        i = int(np.nanargmin(t_rms))
-        if t_rms[i] < best_f:
-            best_x, best_f = block[ok][i], float(t_rms[i])
+        values = np.asarray(batch(block[ok]), dtype=float)
+        if not np.isfinite(values).any():
+            continue
+        i = int(np.nanargmin(values))
+        if values[i] < best_f:
+            best_x, best_f = block[ok][i], float(values[i])
     return best_x, best_f, mesh.shape[0], n_feasible
 
 
-def polish(study: Study, x0: np.ndarray) -> tuple[np.ndarray, float]:
-    """SLSQP from ``x0`` on the analytic T_RMS, with the feasibility margins as constraints and the region's bounds."""
-    mech = study.mechanism
+def polish(problem: DesignProblem, x0: np.ndarray) -> tuple[np.ndarray, float]:
+    """SLSQP from ``x0`` on the batch evaluator, with the margins as constraints and the box as bounds."""
+    batch = _batch(problem)
 
     def objective(x):
-        t_rms, _ = analytic_batch(x[None, :], mech, check=False)
-        return float(t_rms[0]) if np.isfinite(t_rms[0]) else 1e6
+        value = float(np.asarray(batch(np.asarray(x, float)[None, :]), dtype=float)[0])
+        return value if np.isfinite(value) else 1e12
 
     def margins(x):
         # A hair of slack so that SLSQP, which converges onto the active constraint from either side, ends inside.
-        return constraint_margins(x, mech) - 1e-7
+        return problem.constraint_margins(np.atleast_2d(x))[0] - 1e-7
 
-    res = minimize(objective, x0, method="SLSQP", bounds=study.region,
-                   constraints=[{"type": "ineq", "fun": margins}], options={"ftol": 1e-12, "maxiter": 200})
-    x = np.clip(res.x, study.region[:, 0], study.region[:, 1])
-    x = _back_to_feasible(study, np.asarray(x0, float), x)
+    constraints = [{"type": "ineq", "fun": margins}] if problem.constraints else []
+    res = minimize(objective, x0, method="SLSQP", bounds=problem.bounds, constraints=constraints,
+                   options={"ftol": 1e-12, "maxiter": 200})
+    x = np.clip(res.x, problem.bounds[:, 0], problem.bounds[:, 1])
+    x = pull_into_feasible(ModelSpace(problem), x, np.asarray(x0, float)[None, :])
     fx, f0 = objective(x), objective(x0)
-    return (x, fx) if fx < f0 else (np.asarray(x0, float), f0)
+    ok = problem.feasible(x)[0]
+    return (x, fx) if ok and fx < f0 else (np.asarray(x0, float), f0)
 
 
-def _back_to_feasible(study: Study, inside: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """``x`` if feasible, else the feasible point nearest to it on the segment from the feasible ``inside``.
-
-    SLSQP converges onto the active constraint from either side; a design 1e-9 mm outside is still infeasible.
-    """
-    mech = study.mechanism
-    if check_feasibility(x, mech).feasible[0]:
-        return x
-    lo, hi = 0.0, 1.0
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        if check_feasibility(inside + mid * (x - inside), mech).feasible[0]:
-            lo = mid
-        else:
-            hi = mid
-    return inside + lo * (x - inside)
-
-
-def compute_ground_truth(study: Study, step_mm: float = 0.5) -> GroundTruth:
-    """Brute force over the study region on a grid of ``step_mm``, refined locally and polished.
-
-    Parameters
-    ----------
-    study : Study
-        The study (its region and mechanism).
-    step_mm : float
-        Spacing of the coarse grid (mm).
-
-    Returns
-    -------
-    GroundTruth
-    """
+def compute_ground_truth(problem: DesignProblem, step: float) -> GroundTruth:
+    """Brute force over the problem's box on a grid of ``step`` (the variables' unit), refined locally, polished."""
+    if not np.isfinite(step) or step <= 0:
+        raise InputError(f"ground-truth grid step {step!r}: expected a number > 0")
+    box = problem.bounds
+    n = np.prod(np.floor((box[:, 1] - box[:, 0]) / step) + 1)
+    if n > 5e8:
+        raise InputError(f"ground-truth grid step {step:g} gives {n:.3g} designs; expected at most 5e8 (a larger step)")
     start = time.perf_counter()
-    axes = [np.arange(lo, hi + 1e-9, step_mm) for lo, hi in study.region]
-    grid_x, grid_f, n_eval, n_feas = evaluate_grid(study, axes)
+    axes = [np.arange(lo, hi + 1e-9, step) for lo, hi in box]
+    grid_x, grid_f, n_eval, n_feas = evaluate_grid(problem, axes)
     if grid_x is None:
-        raise ValueError(f"no feasible design on the {step_mm} mm grid of study {study.name!r}")
+        raise MechoptError(f"no feasible design on the {step:g} grid of problem {problem.name!r}")
     # Refine on a local grid 20 times finer, then polish: the optimum usually sits on a constraint.
-    fine = [np.clip(np.linspace(c - step_mm, c + step_mm, 41), lo, hi) for c, (lo, hi) in zip(grid_x, study.region,
-                                                                                                  strict=True)]
-    local_x, local_f, _, _ = evaluate_grid(study, [np.unique(a) for a in fine])
+    fine = [np.unique(np.clip(np.linspace(c - step, c + step, 41), lo, hi)) for c, (lo, hi) in zip(grid_x, box,
+                                                                                                      strict=True)]
+    local_x, local_f, _, _ = evaluate_grid(problem, fine)
     if local_x is None or local_f > grid_f:
         local_x, local_f = grid_x, grid_f
-    x, f = polish(study, local_x)
-    report = check_feasibility(x, study.mechanism)
-    return GroundTruth(
-        x=[float(v) for v in x], fun=float(f), grid_x=[float(v) for v in grid_x], grid_fun=float(grid_f),
-        step_mm=step_mm, n_evaluated=n_eval, n_feasible=n_feas, margins=report.margins(0),
-        wall_time_s=time.perf_counter() - start, key=study_key(study, step_mm),
-    )
+    x, f = polish(problem, local_x)
+    return GroundTruth(x=[float(v) for v in x], fun=float(f), grid_x=[float(v) for v in grid_x],
+                       grid_fun=float(grid_f), step=float(step), n_evaluated=int(n_eval), n_feasible=int(n_feas),
+                       wall_time_s=time.perf_counter() - start, key=truth_key(problem, step))
 
 
-def load_or_compute(study: Study, cache: Path, step_mm: float = 0.5) -> GroundTruth:
-    """The ground truth from the JSON ``cache`` if it matches the study, else computed and cached there."""
+def load_or_compute(problem: DesignProblem, cache: Path, step: float, compute: bool = True) -> GroundTruth | None:
+    """The ground truth from the JSON ``cache`` if it matches, else computed and cached (or None if not ``compute``)."""
     cache = Path(cache)
-    key = study_key(study, step_mm)
+    key = truth_key(problem, step)
     if cache.is_file():
         try:
             data = json.loads(cache.read_text())
             if data.get("key") == key:
                 return GroundTruth(**data)
-        except (json.JSONDecodeError, TypeError):
+        except (OSError, json.JSONDecodeError, TypeError):
             pass  # a damaged cache is recomputed
-    truth = compute_ground_truth(study, step_mm)
-    cache.parent.mkdir(parents=True, exist_ok=True)
-    cache.write_text(json.dumps(asdict(truth), indent=2))
+    if not compute:
+        return None
+    truth = compute_ground_truth(problem, step)
+    try:
+        cache.parent.mkdir(parents=True, exist_ok=True)
+        cache.write_text(json.dumps(asdict(truth), indent=2))
+    except OSError as exc:
+        raise InputError(f"cannot write the ground truth cache {cache}: {exc.strerror or exc}") from None
     return truth

@@ -24,6 +24,8 @@ coverage reported.
 
 from __future__ import annotations
 
+import itertools
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -163,7 +165,7 @@ def _node_sets(P: np.ndarray, n_lines: int, shrinks: tuple[float, ...] = _SHRINK
 
 
 def fekete_points(candidates: Any, n_points: int) -> np.ndarray:
-    """Indices of ``n_points`` approximate Fekete points among ``candidates`` (m = 1 or 2 coordinates).
+    """Indices of ``n_points`` approximate Fekete points among ``candidates`` (m = 1 to 3 coordinates).
 
     Greedy maximisation of the Vandermonde volume of the tensor Chebyshev basis of total degree g (the smallest
     with at least ``n_points`` functions) on the candidates' bounding box: the first pivots of a QR factorisation
@@ -194,16 +196,16 @@ def fekete_points(candidates: Any, n_points: int) -> np.ndarray:
     while _dimension(g, m) < n_points:
         g += 1
     tables = [chebvander(S[:, v], g) for v in range(m)]
-    if m == 1:
-        V = tables[0]
-    else:
-        V = np.column_stack([tables[0][:, a] * tables[1][:, b] for a in range(g + 1) for b in range(g + 1 - a)])
+    # Every product of one Chebyshev polynomial per coordinate of total degree <= g.
+    degrees = [idx for idx in itertools.product(range(g + 1), repeat=m) if sum(idx) <= g]
+    V = np.column_stack([np.prod([tables[v][:, a] for v, a in enumerate(idx)], axis=0) for idx in degrees])
     _, _, piv = qr(V.T, mode="economic", pivoting=True)
     return piv[:n_points]
 
 
 def _dimension(g: int, m: int) -> int:
-    return g + 1 if m == 1 else (g + 1) * (g + 2) // 2
+    """Number of polynomials of total degree <= g in m variables."""
+    return math.comb(g + m, m)
 
 
 def _longest_run_lengths(ok: np.ndarray) -> np.ndarray:
@@ -310,7 +312,7 @@ def plan_lines(
     Parameters
     ----------
     lower, upper : (d,) array
-        Box bounds of the design coordinates (caller's units), d = 2 or 3.
+        Box bounds of the design coordinates (caller's units), d = 2 to 4.
     feasible : callable
         ``feasible(X: (n, d) array) -> (n,) bool array``; called on arrays of probe and line points.
     n_lines : int
@@ -346,17 +348,19 @@ def plan_lines(
     Raises
     ------
     SurrogateError
-        Bad bounds, d not in {2, 3}, too few lines, or a feasible region the probes (almost) never hit.
+        Bad bounds, d not in {2, 3, 4}, too few lines, or a feasible region the probes (almost) never hit.
     """
     lo = np.asarray(lower, dtype=float).reshape(-1)
     hi = np.asarray(upper, dtype=float).reshape(-1)
-    if lo.shape != hi.shape or lo.size not in (2, 3):
-        raise SurrogateError(f"lower and upper must be vectors of length 2 or 3, got {lo.shape} and {hi.shape}")
+    if lo.shape != hi.shape or lo.size not in (2, 3, 4):
+        raise SurrogateError(f"lower and upper must be vectors of length 2 to 4, got {lo.shape} and {hi.shape}")
     if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi)) and np.all(hi > lo)):
         raise SurrogateError(f"need finite bounds with upper > lower, got lower={lo.tolist()}, upper={hi.tolist()}")
     dim = lo.size
     if layout not in LAYOUTS:
         raise SurrogateError(f"layout must be one of {', '.join(LAYOUTS)}, got {layout!r}")
+    if layout == "boundary" and dim > 3:
+        raise SurrogateError(f"layout 'boundary' places nodes on a polygon (d <= 3); use 'fekete' for d = {dim}")
     if int(n_lines) < dim:
         raise SurrogateError(f"n_lines must be >= d = {dim} for the hull to have volume, got {n_lines}")
     if spacing is not None and not (np.isfinite(spacing) and spacing > 0):

@@ -13,9 +13,9 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 def ventilator():
     from mechopt.studies.definition import load_study
 
-    return load_study("ventilator")
+    return load_study("ventilator", {"engine": "pymunk"})
 
 
 @pytest.fixture(scope="session")
 def mechanism(ventilator):
-    return ventilator.mechanism
+    return ventilator.problem.mechanism

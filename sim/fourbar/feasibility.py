@@ -19,8 +19,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from mechopt.errors import InfeasibleDesignError, InputError
 from numba import njit, prange
+
+from mechopt.errors import InfeasibleDesignError, InputError
 
 from .kinematics import _crank_kernel
 from .mechanism import FourBar
@@ -28,7 +29,7 @@ from .mechanism import FourBar
 #: ψ samples along the stroke at which the along-stroke constraints are checked.
 N_CHECK = 241
 
-_COLUMNS = ("assembly_start_mm", "assembly_end_mm", "assembly_stroke_mm", "monotonic_deg", "toggle_deg")
+MARGIN_NAMES = ("assembly_start_mm", "assembly_end_mm", "assembly_stroke_mm", "monotonic_deg", "toggle_deg")
 
 
 @njit(cache=True)
@@ -131,7 +132,7 @@ class FeasibilityReport:
 
     def margins(self, i: int = 0) -> dict[str, float]:
         """Margins of design ``i`` as a dict (mm or deg, see the attribute names)."""
-        return {name: float(getattr(self, name)[i]) for name in _COLUMNS}
+        return {name: float(getattr(self, name)[i]) for name in MARGIN_NAMES}
 
     def message(self, i: int = 0) -> str:
         """One line saying whether design ``i`` is feasible, and else which constraint fails by how much."""
@@ -188,14 +189,14 @@ def check_feasibility(designs: np.ndarray, mechanism: FourBar, n_check: int = N_
         Margins per design; ``report.feasible`` is the boolean mask.
     """
     arr = as_designs(designs)
-    out = np.empty((arr.shape[0], len(_COLUMNS)))
+    out = np.empty((arr.shape[0], len(MARGIN_NAMES)))
     xc, yc = mechanism.pivot_c
     psi = np.linspace(mechanism.psi_start, mechanism.psi_end, int(n_check))
     _margins_many(
         arr, xc, yc, mechanism.psi_start, mechanism.psi_end, mechanism.branch,
         np.radians(mechanism.toggle_margin_deg), np.cos(psi), np.sin(psi), out,
     )
-    return FeasibilityReport(arr, *(out[:, k] for k in range(len(_COLUMNS))))
+    return FeasibilityReport(arr, *(out[:, k] for k in range(len(MARGIN_NAMES))))
 
 
 def feasible_mask(designs: np.ndarray, mechanism: FourBar, n_check: int = N_CHECK) -> np.ndarray:
@@ -232,8 +233,8 @@ def constraint_margins(designs: np.ndarray, mechanism: FourBar) -> np.ndarray:
     x = np.asarray(designs, dtype=float)
     flat = np.atleast_2d(x)
     valid = np.all(np.isfinite(flat) & (flat > 0), axis=1)
-    out = np.full((flat.shape[0], len(_COLUMNS)), -1e3)
+    out = np.full((flat.shape[0], len(MARGIN_NAMES)), -1e3)
     if valid.any():
         report = check_feasibility(flat[valid], mechanism)
-        out[valid] = np.nan_to_num(np.column_stack([getattr(report, c) for c in _COLUMNS]), nan=-1e3)
+        out[valid] = np.nan_to_num(np.column_stack([getattr(report, c) for c in MARGIN_NAMES]), nan=-1e3)
     return out[0] if x.ndim == 1 else out

@@ -15,8 +15,9 @@ pymunk simulation, so every engine sees the same kinematics.
 from __future__ import annotations
 
 import numpy as np
-from mechopt.errors import InputError
 from numba import njit
+
+from mechopt.errors import InputError
 
 #: Branch of Eq. 4: −1 subtracts the arccos term (θ1, the paper's elbow-up), +1 adds it (θ2).
 BRANCH_SUBTRACT = -1

@@ -9,9 +9,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from mechopt.errors import InputError
 from numba import njit
 from scipy.interpolate import CubicSpline
+
+from mechopt.errors import InputError
 
 
 @njit(cache=True)

@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+
 from mechopt.errors import InputError
 
 from .kinematics import BRANCH_SUBTRACT, validate_pivot

@@ -9,8 +9,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from mechopt.errors import InputError
 from numba import njit
+
+from mechopt.errors import InputError
 
 #: Law codes shared with the numba kernels (a string cannot cross into nopython code cheaply).
 LAW_CODES = {"quintic": 0, "cycloidal": 1}

@@ -1,16 +1,18 @@
-"""One entry point for both engines: ``simulate(design, mechanism, engine=...)``."""
+"""One entry point for the engines: ``simulate(design, mechanism, engine=...)``."""
 
 from __future__ import annotations
 
 import numpy as np
+
 from mechopt.errors import InputError
 
 from .analytic import simulate_analytic
+from .exudyn_engine import simulate_exudyn
 from .mechanism import FourBar
 from .pymunk_engine import simulate_pymunk
 from .result import SimulationResult
 
-ENGINES = ("pymunk", "analytic")
+ENGINES = ("pymunk", "analytic", "exudyn")
 
 
 def simulate(
@@ -25,9 +27,11 @@ def simulate(
     mechanism : FourBar
         The fixed part of the mechanism (pivot C, inertias, load, motion).
     engine : str
-        ``"pymunk"`` (rigid-body motion simulation, the stand-in for CAD) or ``"analytic"`` (inverse dynamics).
+        ``"pymunk"`` (rigid-body motion simulation, the stand-in for CAD), ``"analytic"`` (inverse dynamics) or
+        ``"exudyn"`` (Exudyn multibody simulation; exudyn is imported on first use).
     **options
-        Passed to :func:`sim.pymunk_sim.simulate_pymunk` or :func:`sim.analytic.simulate_analytic`.
+        Passed to :func:`.pymunk_engine.simulate_pymunk`, :func:`.analytic.simulate_analytic` or
+        :func:`.exudyn_engine.simulate_exudyn`.
 
     Returns
     -------
@@ -45,4 +49,6 @@ def simulate(
         return simulate_pymunk(design, mechanism, **options)
     if engine == "analytic":
         return simulate_analytic(design, mechanism, **options)
+    if engine == "exudyn":
+        return simulate_exudyn(design, mechanism, **options)
     raise InputError(f"unknown engine {engine!r}; expected one of {', '.join(ENGINES)}")

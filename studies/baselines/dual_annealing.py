@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import OptimizeResult, dual_annealing
 
+from ..sparse.local_search import feasible_side_gradient
 from .problem import BudgetExhausted, CountedProblem
-from .slsqp import feasible_side_gradient
 
 __all__ = ["minimize_dual_annealing"]
 

@@ -4,6 +4,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+
 from mechopt.sim.fourbar.analytic import analytic_batch, simulate_analytic, torque_curve
 from mechopt.sim.fourbar.kinematics import crank_angle, joint_positions
 
@@ -68,7 +69,7 @@ def test_original_design_figures(ventilator, mechanism):
 
 def test_batch_equals_single(ventilator, mechanism):
     rng = np.random.default_rng(3)
-    designs = rng.uniform(ventilator.region[:, 0], ventilator.region[:, 1], size=(300, 3))
+    designs = rng.uniform(ventilator.problem.bounds[:, 0], ventilator.problem.bounds[:, 1], size=(300, 3))
     t_rms, t_max = analytic_batch(designs, mechanism)
     ok = np.flatnonzero(np.isfinite(t_rms))
     assert ok.size > 50

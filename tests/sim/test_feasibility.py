@@ -2,13 +2,14 @@
 
 import numpy as np
 import pytest
+from scipy.optimize import brentq
+
 from mechopt.errors import InfeasibleDesignError
 from mechopt.sim.fourbar.feasibility import check_feasibility, feasible_mask, require_movable
 from mechopt.sim.fourbar.kinematics import crank_angle
 from mechopt.sim.fourbar.load import RockerLoad
 from mechopt.sim.fourbar.mechanism import FourBar
 from mechopt.sim.fourbar.motion import MotionLaw
-from scipy.optimize import brentq
 
 
 def _straddle(mechanism, column, base, index, lo, hi):
@@ -95,7 +96,7 @@ def test_two_defects_between_the_ends_are_caught():
 
 def test_vectorised_equals_one_by_one(mechanism, ventilator):
     rng = np.random.default_rng(7)
-    designs = rng.uniform(ventilator.region[:, 0], ventilator.region[:, 1], size=(40, 3))
+    designs = rng.uniform(ventilator.problem.bounds[:, 0], ventilator.problem.bounds[:, 1], size=(40, 3))
     batch = check_feasibility(designs, mechanism)
     for i in range(0, 40, 7):
         single = check_feasibility(designs[i], mechanism)

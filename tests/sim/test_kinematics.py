@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+
 from mechopt.errors import InputError
 from mechopt.sim.fourbar.kinematics import check_design, crank_angle, joint_positions, rocker_angle
 from mechopt.sim.fourbar.pymunk_engine import simulate_pymunk

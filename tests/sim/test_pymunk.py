@@ -2,11 +2,12 @@
 
 import numpy as np
 import pytest
+from scipy.optimize import brentq
+
 from mechopt.sim.fourbar.analytic import MM, simulate_analytic, torque_curve
 from mechopt.sim.fourbar.feasibility import check_feasibility
 from mechopt.sim.fourbar.kinematics import crank_angle
 from mechopt.sim.fourbar.pymunk_engine import _run, simulate_pymunk
-from scipy.optimize import brentq
 
 
 def _boundary_design(mechanism, base, distance_mm):
@@ -23,7 +24,7 @@ def _random_feasible(ventilator, mechanism, n, seed):
     rng = np.random.default_rng(seed)
     out = []
     while len(out) < n:
-        d = rng.uniform(ventilator.region[:, 0], ventilator.region[:, 1])
+        d = rng.uniform(ventilator.problem.bounds[:, 0], ventilator.problem.bounds[:, 1])
         if check_feasibility(d, mechanism).feasible[0]:
             out.append(d)
     return out

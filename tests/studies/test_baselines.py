@@ -15,13 +15,14 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.optimize import check_grad
+from scipy.spatial import Delaunay
+
 from mechopt.studies.baselines import BASELINE_DOCS, BASELINES, BudgetExhausted, CountedProblem, fit_and_search_rbf
 from mechopt.studies.baselines.bayesian import GaussianProcess, expected_improvement
 from mechopt.studies.baselines.genetic import polynomial_mutation, sbx_crossover
 from mechopt.studies.baselines.powell_penalty import minimize_powell_penalty
 from mechopt.studies.baselines.problem import run_multistart
-from scipy.optimize import check_grad
-from scipy.spatial import Delaunay
 
 BOX = np.array([[-2.0, 2.0]] * 3)
 

@@ -5,13 +5,14 @@ import subprocess
 import sys
 
 import pytest
+
 from mechopt.studies.cli import EXIT_ERROR, EXIT_INFEASIBLE, main
 
 
 def test_simulate_prints_feasibility_and_torques(capsys):
     assert main(["simulate", "--oa", "53", "--ab", "65", "--bc", "282", "--engine", "analytic"]) == 0
     out = capsys.readouterr().out
-    assert "feasible" in out and "T_RMS = 4.77" in out and "T_max = 8.06" in out
+    assert "feasible" in out and "t_rms = 4.77" in out and "t_max = 8.06" in out
 
 
 def test_simulate_json_and_plot(capsys, tmp_path):
@@ -19,7 +20,8 @@ def test_simulate_json_and_plot(capsys, tmp_path):
     assert main(["simulate", "--oa", "53", "--ab", "65", "--bc", "282", "--json", "--plot", str(png)]) == 0
     payload = json.loads(capsys.readouterr().out)
     assert payload["engine"] == "pymunk" and payload["feasible"] is True
-    assert payload["t_rms_Nm"] == pytest.approx(4.78, abs=0.01)
+    assert payload["outputs"]["t_rms"] == pytest.approx(4.78, abs=0.01)
+    assert payload["design"] == {"oa": 53.0, "ab": 65.0, "bc": 282.0}
     assert png.stat().st_size > 20_000
 
 
@@ -42,7 +44,7 @@ def _bad_toml(tmp_path, text):
     [
         (["--oa", "0", "--ab", "65", "--bc", "282"], "|OA| = 0 mm"),
         (["--oa", "53", "--ab", "-65", "--bc", "282"], "|AB| = -65 mm"),
-        (["--oa", "53", "--ab", "65", "--bc", "nan"], "|BC| = nan mm"),
+        (["--oa", "53", "--ab", "65", "--bc", "nan"], "--bc = nan"),
         (["--oa", "53", "--ab", "65", "--bc", "282", "--study", "nosuch"], "unknown study 'nosuch'"),
     ],
 )
@@ -56,12 +58,15 @@ def test_bad_input_is_one_line(capsys, args, expected):
     ("text", "expected"),
     [
         ("name = 'x'\n[mechanism\n", "malformed TOML"),
-        ("name = 'x'\n", "missing section [mechanism]"),
-        ("[mechanism]\nground = 'explicit'\n[motion]\nstroke_time_s = 0.2\n", "missing key pivot_c_mm"),
-        ("[mechanism]\nground = 'explicit'\npivot_c_mm = [1, 2]\nj0_kgm2 = 1e-3\ni_r_kgm2 = 0.2\ncolour = 3\n"
-         "[motion]\nstroke_time_s = 0.2\n", "unknown key mechanism.colour"),
-        ("[mechanism]\nground = 'explicit'\npivot_c_mm = [1, 2]\nj0_kgm2 = 'heavy'\ni_r_kgm2 = 0.2\n"
-         "[motion]\nstroke_time_s = 0.2\n", "key j0_kgm2 = 'heavy'"),
+        ("name = 'x'\n", "missing key kind"),
+        ("name = 'x'\nkind = 'five-bar'\n", "unknown mechanism kind 'five-bar'"),
+        ("kind = 'four-bar'\n", "missing section [mechanism]"),
+        ("kind = 'four-bar'\n[mechanism]\nground = 'explicit'\n[motion]\nstroke_time_s = 0.2\n",
+         "missing key mechanism.pivot_c_mm"),
+        ("kind = 'four-bar'\n[mechanism]\nground = 'explicit'\npivot_c_mm = [1, 2]\nj0_kgm2 = 1e-3\n"
+         "i_r_kgm2 = 0.2\ncolour = 3\n[motion]\nstroke_time_s = 0.2\n", "unknown key mechanism.colour"),
+        ("kind = 'four-bar'\n[mechanism]\nground = 'explicit'\npivot_c_mm = [1, 2]\nj0_kgm2 = 'heavy'\n"
+         "i_r_kgm2 = 0.2\n[motion]\nstroke_time_s = 0.2\n", "key mechanism.j0_kgm2 = 'heavy'"),
     ],
 )
 def test_malformed_or_incomplete_toml(capsys, tmp_path, text, expected):
@@ -75,12 +80,13 @@ def test_explicit_study_file(tmp_path, capsys):
     # A second study is just a TOML file: explicit pivot, inertias, stroke and a constant load.
     path = tmp_path / "bench.toml"
     path.write_text(
-        "name = 'bench'\n[mechanism]\nground = 'explicit'\npivot_c_mm = [-235.0, 11.0]\nj0_kgm2 = 1.7e-3\n"
-        "i_r_kgm2 = 0.2\n[motion]\nstroke_time_s = 0.2\npsi_start_deg = 16.4\npsi_end_deg = 6.2\n"
-        "[load]\nrocker_Nm = 0.0\n[region]\noa_mm = [30, 60]\nab_mm = [60, 130]\nbc_mm = [250, 350]\n"
+        "name = 'bench'\nkind = 'four-bar'\n[mechanism]\nground = 'explicit'\npivot_c_mm = [-235.0, 11.0]\n"
+        "j0_kgm2 = 1.7e-3\ni_r_kgm2 = 0.2\n[motion]\nstroke_time_s = 0.2\npsi_start_deg = 16.4\n"
+        "psi_end_deg = 6.2\n[load]\nrocker_Nm = 0.0\n[variables]\noa = [30, 60]\nab = [60, 130]\n"
+        "bc = [250, 350]\n"
     )
     assert main(["simulate", "--oa", "53", "--ab", "65", "--bc", "282", "--study", str(path), "--json"]) == 0
-    assert json.loads(capsys.readouterr().out)["t_rms_Nm"] > 0
+    assert json.loads(capsys.readouterr().out)["outputs"]["t_rms"] > 0
 
 
 def test_console_script_without_traceback():

@@ -2,12 +2,13 @@
 
 import numpy as np
 import pytest
+
 from mechopt.sim.fourbar.analytic import simulate_analytic
 from mechopt.sim.fourbar.pymunk_engine import simulate_pymunk
 
 
 def test_reconstruction_matches_the_data_readme(ventilator):
-    rec = ventilator.reconstruction
+    rec = ventilator.problem.reconstruction
     # README: C = (−235.22, 10.97) mm, J0 = 1.6537e-3 kg m², I_r = 0.20902 kg m², ψ_start = 16.407°, ψ_end = 6.176°,
     # 0.06 % relative RMS misfit.  Our fit uses exact dψ/dθ and lands 0.2 mm away with a 30 times smaller misfit;
     # the tolerances below are the distance between the two fits, not slack.
@@ -25,9 +26,9 @@ def test_reconstruction_matches_the_data_readme(ventilator):
 
 def test_reconstructed_inertia_reproduces_the_table(ventilator):
     from mechopt.sim.fourbar.kinematics import rocker_angle
-    from mechopt.studies.ventilator.reconstruction import read_motor_table
+    from mechopt.sim.fourbar.reconstruction import read_motor_table
 
-    rec = ventilator.reconstruction
+    rec = ventilator.problem.reconstruction
     table = read_motor_table(ventilator.path.parent / "original_design_load_inertia.csv")
     _, ratio = rocker_angle((53.0, 65.0, 282.0), rec.pivot_c, table.theta, rec.forward_branch)
     model = rec.j0 + rec.i_r * ratio**2
@@ -38,6 +39,6 @@ def test_reconstructed_inertia_reproduces_the_table(ventilator):
 def test_original_design_with_both_engines(ventilator, engine):
     design = ventilator.design("original")
     sim = simulate_analytic if engine == "analytic" else simulate_pymunk
-    result = sim(design, ventilator.mechanism)
+    result = sim(design, ventilator.problem.mechanism)
     assert result.t_rms == pytest.approx(4.78, abs=0.01)
     assert result.t_max == pytest.approx(8.06, abs=0.01)

@@ -5,16 +5,19 @@ import re
 
 import numpy as np
 import pytest
+
 from mechopt.studies.cli import EXIT_ERROR, main
 
 SMALL = ["--engine", "analytic", "--workers", "1", "--no-progress", "--samples-per-line", "24",
          "--search-points", "200000", "--points-per-line", "8"]
+#: The ventilator's true optimum, T_RMS in N·m (brute force: see test_ground_truth.py).
+T_TRUE = 1.7582
 
 
 @pytest.fixture(scope="module")
 def study_dir(tmp_path_factory):
     out = tmp_path_factory.mktemp("study")
-    assert main(["study", "ventilator", "--out", str(out), "--lines", "6", "--truth-grid", "2", *SMALL]) == 0
+    assert main(["study", "ventilator", "--out", str(out), "--lines", "6", *SMALL]) == 0
     return out
 
 
@@ -25,16 +28,20 @@ def _is_png(path, min_bytes=10_000):
 
 def test_study_writes_result_report_and_figures(study_dir):
     result = json.loads((study_dir / "result.json").read_text())
-    assert result["simulations"]["fit"] < 618
+    assert result["simulations"]["model_lines"] < 618
     assert result["validation"]["n_points"] >= 40
     # The global model (21 lines at Fekete nodes, blended T_RMS²) on held-out lines: RMSE within 1 % of T_min.
-    assert result["validation"]["rmse_Nm"] <= 0.01 * result["ground_truth"]["t_rms_Nm"], result["validation"]
+    assert result["validation"]["rmse"] <= 0.01 * T_TRUE, result["validation"]
     opt = result["optimum"]
-    assert opt["t_rms_Nm"] < 0.5 * result["designs"][0]["t_rms_Nm"]  # far better than the original
+    original = next(d for d in result["designs"] if d["name"] == "original")
+    assert opt["objective"] < 0.5 * original["outputs"]["t_rms"]  # far better than the original
     # Within 0.5 % of the brute-force ground truth even in this small configuration.
-    assert result["ground_truth"]["gap_pct"] < 0.5
+    assert opt["objective"] < 1.005 * T_TRUE
+    assert result["ground_truth"] is None  # opt-in: not part of every study run
+    sims = result["simulations"]
+    assert sims["new"] + sims["reused"] == sims["distinct_designs"] and sims["executor"]
     report = (study_dir / "report.md").read_text()
-    assert "| original |" in report and "paper_global_optimum" in report
+    assert "| original |" in report and "paper_global_optimum" in report and "reused from the store" in report
     for rel in result["figures"].values():
         path = study_dir / rel
         assert path.is_file() and path.stat().st_size > 10_000, rel
@@ -47,45 +54,52 @@ def test_study_writes_result_report_and_figures(study_dir):
 
 def test_rerun_resumes_from_the_store(study_dir, tmp_path, capsys):
     from mechopt.studies.definition import load_study
-    from mechopt.studies.evaluate import Evaluator
     from mechopt.studies.store import SampleStore
 
-    study = load_study("ventilator")
-    key = Evaluator(study.mechanism, "analytic", study.name).settings_hash()
+    key = load_study("ventilator", {"engine": "analytic"}).problem.fingerprint()
     with SampleStore(study_dir / "samples.sqlite") as store:
         before = store.count(key)
     # Another output folder, the same store named with --store: everything comes from the store.
     other = tmp_path / "again"
     assert main(["study", "ventilator", "--out", str(other), "--store", str(study_dir / "samples.sqlite"),
-                 "--lines", "6", "--truth-grid", "2", *SMALL]) == 0
+                 "--lines", "6", *SMALL]) == 0
     with SampleStore(study_dir / "samples.sqlite") as store:
         assert store.count(key) == before  # nothing simulated twice
     assert not (other / "samples.sqlite").exists() and (other / "result.json").is_file()
+    result = json.loads((other / "result.json").read_text())
+    assert result["simulations"]["new"] == 0 and result["simulations"]["reused"] == before
+    assert "0 new" in capsys.readouterr().out
 
 
 def test_validate_reuses_the_model(study_dir, capsys):
     assert main(["validate", "--out", str(study_dir), "--lines", "2", *SMALL]) == 0
     out = capsys.readouterr().out
     assert "model read from" in out and "held-out simulations on 2 lines" in out
-    assert _is_png(study_dir / "figures" / "validation.png")
+    # Its own figure: the study's validation figure is not overwritten.
+    assert _is_png(study_dir / "figures" / "validation_heldout.png") and _is_png(study_dir / "figures" /
+                                                                                  "validation.png")
+    # One definition of the reference minimum: the study's best simulated design.
+    result = json.loads((study_dir / "result.json").read_text())
+    assert f"{result['optimum']['objective']:.4g}" in out
 
 
 def test_feasible_plots(tmp_path, capsys):
     assert main(["feasible", "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "of the region is feasible" in out and "original" in out
-    assert _is_png(tmp_path / "figures" / "feasible_slices.png", 50_000)
-    assert _is_png(tmp_path / "figures" / "feasible_3d.png", 50_000)
+    assert _is_png(tmp_path / "figures" / "feasible_slices_all_designs.png", 50_000)
+    assert _is_png(tmp_path / "figures" / "feasible_3d_all_designs.png", 50_000)
 
 
 @pytest.mark.parametrize(
     ("section", "expected"),
     [
         ("n_lines = 'seven'", "surrogate.n_lines"),
-        ("lines = 7", "unknown key surrogate.lines"),
+        ("lines = 7", "unknown option surrogate.lines"),
         ("plan = 'magic'", "surrogate.plan"),
         ("layout = 'grid'", "surrogate.layout"),
-        ("target = 'log'", "surrogate.target"),
+        ("fit = 'log'", "surrogate.fit"),
+        ("refine = 'yes'", "surrogate.refine"),
     ],
 )
 def test_bad_study_keys(tmp_path, capsys, section, expected):
@@ -106,12 +120,13 @@ def test_bad_study_keys(tmp_path, capsys, section, expected):
 
 def test_paper_plan_is_expressible():
     from mechopt.studies.definition import load_study
-    from mechopt.studies.design_space import DesignSpace
-    from mechopt.studies.workflow import SurrogateOptions, _paper_plan
+    from mechopt.studies.run import study_options
+    from mechopt.studies.sparse.space import ModelSpace
+    from mechopt.studies.sparse.stage import paper_plan
 
     study = load_study("ventilator")
-    opts = SurrogateOptions(plan="paper", samples_per_line=30, min_samples=10)
-    plan, coverage = _paper_plan(DesignSpace(study.mechanism, study.region), opts)
+    opts = study_options(study, {"plan": "paper", "samples_per_line": 30, "min_samples": 10})
+    plan, coverage = paper_plan(ModelSpace(study.problem), opts)
     np.testing.assert_allclose(plan.direction, [0.0, 0.920, 0.503])
     np.testing.assert_allclose(plan.origin, [31.000, 257.859, 72.705])
     assert 0 < coverage <= 1

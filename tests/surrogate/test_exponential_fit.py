@@ -6,6 +6,7 @@ import warnings
 
 import numpy as np
 import pytest
+
 from mechopt.surrogate import ExponentialFit, SurrogateError, SurrogateWarning, fit_exponential
 
 METHODS = [("matrix_pencil", "ls"), ("matrix_pencil", "tls"), ("esprit", "ls"), ("esprit", "tls")]

@@ -6,6 +6,7 @@ import json
 
 import numpy as np
 import pytest
+
 from mechopt.surrogate import LineHull, LinePlan, SurrogateError, normal_basis
 
 PAPER_DELTA = np.array([0.000, 0.920, 0.503])  # Δ_u = 0 makes the paper's own (p, q) of Eq. 16 degenerate

@@ -6,6 +6,7 @@ import time
 
 import numpy as np
 import pytest
+
 from mechopt.surrogate import LinePlan, SurrogateError, coverage, plan_lines
 
 
@@ -78,7 +79,7 @@ def test_explicit_spacing_is_used():
     [
         (([0, 0, 0], [1, 1, 1]), {"n_lines": 2}, r"n_lines must be >= d = 3 .*, got 2"),
         (([0, 0, 0], [1, 0, 1]), {}, r"upper > lower"),
-        (([0, 0, 0, 0], [1, 1, 1, 1]), {}, r"length 2 or 3"),
+        (([0, 0, 0, 0, 0], [1, 1, 1, 1, 1]), {}, r"length 2 to 4"),
         (([0, 0, 0], [1, 1, 1]), {"spacing": -1.0}, r"spacing must be a positive length, got -1.0"),
     ],
 )

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+
 from mechopt.surrogate import LinePlan, SparseExponentialModel, exhaustive_search, grid_minimum, hull_grid
 
 PAPER_DELTA = np.array([0.000, 0.920, 0.503])

@@ -14,10 +14,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from scipy.optimize import least_squares
+
 from mechopt.errors import StudyError
 from mechopt.sim.fourbar.kinematics import crank_angle, rocker_angle
 from mechopt.sim.fourbar.load import RockerLoad
-from scipy.optimize import least_squares
 
 
 @dataclass(frozen=True)
