@@ -43,7 +43,22 @@ _LAZY = {
     "register_mechanism": "mechopt.sim.registry",
 }
 
-__all__ = sorted(["InfeasibleDesignError", "InputError", "MechoptError", "StudyError", *_LAZY])
+__all__ = [  # noqa: RUF022 - the eager names first, then the lazy ones
+    "InfeasibleDesignError",
+    "InputError",
+    "MechoptError",
+    "StudyError",
+    "DesignProblem",
+    "Variable",
+    "minimize",
+    "OptimizeResult",
+    "load_study",
+    "available_studies",
+    "SparseOptions",
+    "ObjectiveModel",
+    "SampleStore",
+    "register_mechanism",
+]
 
 
 def __getattr__(name: str):

@@ -23,6 +23,7 @@ MECHANISMS: dict[str, str] = {
     "offset-crank-slider": "mechopt.sim.slider_crank.offset_study:problem_from_study",
     "rowing": "mechopt.sim.slider_crank.rowing_study:problem_from_study",
     "flexible-slider-crank": "mechopt.studies.flexible_slider_crank.problem:problem_from_study",
+    "external": "mechopt.sim.simulators.external:problem_from_study",
 }
 
 _REGISTERED: dict[str, Callable[..., Any]] = {}

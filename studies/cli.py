@@ -207,9 +207,9 @@ def _cmd_validate(args: argparse.Namespace, rest: list[str]) -> int:
     figure = plot_validation(val.lines, out / "figures" / "validation_heldout.png", fit_lines, model,
                              label=study.problem.objective)
     (out / "validation.json").write_text(json.dumps(val.summary(), indent=2))
-    print(f"{val.n_points} held-out simulations on {len(val.lines)} lines: RMSE {val.rmse:.4g} ({val.rmse_pct:.2f} % "
-          f"of the best simulated {study.problem.objective} {val.f_min:.4g}), {val.rmse_low:.4g} where it is <= 2 × "
-          f"that, max error {val.max_error:.4g}")
+    print(f"{val.n_points} held-out simulations on {len(val.lines)} lines: RMSE {val.rmse:.4g} "
+          f"({val.relative_text()}), {val.rmse_low:.4g} where {study.problem.objective} is <= 2 × the best simulated "
+          f"value, max error {val.max_error:.4g}")
     print(f"figure written to {figure}")
     return 0
 
@@ -283,7 +283,7 @@ def _cmd_init(args: argparse.Namespace, rest: list[str]) -> int:
         to.mkdir(parents=True, exist_ok=True)
         copied = []
         for f in sorted(folder.iterdir()):
-            if f.is_file() and f.suffix in (".toml", ".csv", ".md", ".json"):
+            if f.is_file() and f.suffix in (".toml", ".csv", ".md", ".json", ".py") and f.name != "__init__.py":
                 shutil.copy2(f, to / f.name)
                 copied.append(f.name)
     except OSError as exc:
@@ -298,20 +298,39 @@ def _cmd_compare(args: argparse.Namespace, rest: list[str]) -> int:
     from .ground_truth import load_or_compute
     from .run import check_output_folder
 
-    study = _load(args)
-    engine = args.engine or study.section("compare").get("engine")
-    if engine:
-        args.engine = engine
-        study = _load(args)
-    out = check_output_folder(Path(args.out or f"{study.name}-study"))
-    print(f"ground truth of {study.name} (brute force, grid {args.truth_grid:g}; cached in {out})")
-    truth = load_or_compute(study.problem, out / f"ground_truth_{args.truth_grid:g}.json", args.truth_grid)
-    print(f"  {study.problem.objective} {truth.fun:.6g} at {study.problem.describe(np.array(truth.x))}")
+    names = [n for n in args.study.split(",") if n]
     methods = args.methods.split(",") if args.methods else None
-    runs = cmp.compare(study, truth, args.budgets, args.seeds, methods)
-    md, fig = cmp.write(runs, truth, out, study, args.seeds)
-    print(md.read_text())
-    print(f"table written to {md}, figure to {fig}")
+    studies = []
+    for name in names:  # every study loaded and checked before any run
+        args.study = name
+        engine = args.engine
+        study = _load(args)
+        engine = engine or study.section("compare").get("engine")
+        if engine:
+            study = _load(argparse.Namespace(study=name, engine=engine))
+        studies.append(study)
+    base = Path(args.out or (f"{names[0]}-study" if len(names) == 1 else "compare"))
+    needed, budgets = {}, {}
+    for study in studies:
+        out = check_output_folder(base if len(studies) == 1 else base / study.name)
+        truth = cmp.known_truth(study.problem)
+        if truth is None:
+            print(f"ground truth of {study.name} (brute force, grid {args.truth_grid:g}; cached in {out})")
+            truth = load_or_compute(study.problem, out / f"ground_truth_{args.truth_grid:g}.json", args.truth_grid)
+        print(f"{study.name}: optimum {study.problem.objective} {truth.fun:.6g} at "
+              f"{study.problem.describe(np.array(truth.x))}")
+        runs = cmp.compare(study, truth, args.budgets, args.seeds, methods)
+        md, fig = cmp.write(runs, truth, out, study, args.seeds)
+        print(md.read_text())
+        print(f"table written to {md}, figure to {fig}")
+        needed[study.name] = cmp.simulations_needed(cmp.table(runs, study.problem, truth))
+        budgets[study.name] = max(args.budgets)
+    if len(studies) > 1:
+        text = cmp.headline(needed, budgets)
+        (base / "headline.md").write_text(text)
+        fig = cmp.plot_headline(needed, budgets, base / "figures" / "compare_headline.png")
+        print(text)
+        print(f"headline written to {base / 'headline.md'}, figure to {fig}")
     return 0
 
 
@@ -376,7 +395,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_truth)
 
     p = sub.add_parser("compare", help="mechopt against other optimizers at equal simulation budgets")
-    study_arg(p)
+    p.add_argument("--study", default="ventilator", help="study names or .toml paths, comma separated; also the "
+                   "multimodal test functions (hartmann3, cosine_bowl3, branin, six_hump_camel, himmelblau_disc)")
+    p.add_argument("--engine", choices=ENGINES, help="simulation engine (default: the study's [compare] engine)")
     p.add_argument("--budgets", type=_int_list, default=[50, 100, 200, 618, 1870],
                    help="simulation budgets, comma separated (default 50,100,200,618,1870)")
     p.add_argument("--seeds", type=_positive_int, default=5, help="seeds per method and budget (default 5)")

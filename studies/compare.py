@@ -54,10 +54,39 @@ class Run:
     wall_time_s: float
 
 
+def known_truth(problem: DesignProblem) -> GroundTruth | None:
+    """The optimum a problem declares (``f_min``, ``x_min``: test functions, a synthesis against a known target)."""
+    f_min = getattr(problem, "f_min", None)
+    if f_min is None or not np.isfinite(f_min):
+        return None
+    x = np.atleast_2d(np.asarray(getattr(problem, "x_min", np.full((1, problem.dim), np.nan)), dtype=float))[0]
+    return GroundTruth(x=x.tolist(), fun=float(f_min), grid_x=x.tolist(), grid_fun=float(f_min), step=0.0,
+                       n_evaluated=0, n_feasible=0, wall_time_s=0.0, key="known")
+
+
+def tolerance(problem: DesignProblem, truth: GroundTruth) -> float:
+    """How close to the optimum counts as reaching it: 0.5 % of the function's range over the box where the problem
+    declares it (test functions), 0.5 % of the optimum, or 1e-6 absolute where the optimum is 0."""
+    f_range = getattr(problem, "f_range", None)
+    if f_range is not None and np.isfinite(f_range) and f_range > 0:
+        return 0.005 * float(f_range)
+    return 0.005 * abs(truth.fun) if truth.fun else 1e-6
+
+
+def gap_pct(problem: DesignProblem, truth: GroundTruth, value: float) -> float:
+    """The gap in per cent: of the range over the box (test functions), of the optimum, or ×1e6 absolute at 0."""
+    if not np.isfinite(value):
+        return float("nan")
+    f_range = getattr(problem, "f_range", None)
+    if f_range is not None and np.isfinite(f_range) and f_range > 0:
+        return 100 * (value - truth.fun) / f_range
+    return 100 * (value / truth.fun - 1) if truth.fun else 100 * value
+
+
 def compare(study: Study, truth: GroundTruth, budgets: list[int], seeds: int, methods: list[str] | None = None,
             progress=print) -> list[Run]:
     """Run every method at every budget and seed; returns the runs (see :func:`table`)."""
-    names = ["mechopt", *BASELINES]
+    names = ["mechopt", "mechopt-global", *BASELINES]
     if methods:
         unknown = sorted(set(methods) - set(names))
         if unknown:
@@ -72,7 +101,8 @@ def compare(study: Study, truth: GroundTruth, budgets: list[int], seeds: int, me
                     continue
                 t0 = time.perf_counter()
                 try:
-                    res = minimize(problem, budget=budget, method="sparse" if name == "mechopt" else name, seed=seed)
+                    method = {"mechopt": "sparse", "mechopt-global": "sparse-global"}.get(name, name)
+                    res = minimize(problem, budget=budget, method=method, seed=seed)
                     x = np.asarray(res.x) if res.success else None
                     nfev = int(res.nfev)
                 except (SurrogateError, MechoptError) as exc:
@@ -80,15 +110,17 @@ def compare(study: Study, truth: GroundTruth, budgets: list[int], seeds: int, me
                     progress(f"  {name} at budget {budget}, seed {seed}: {exc}")
                     x, nfev = None, 0
                 value = true_objective(problem, x)
-                gap = 100 * (value / truth.fun - 1) if np.isfinite(value) and truth.fun else float("nan")
+                gap = gap_pct(problem, truth, value)
                 runs.append(Run(name, budget, seed, None if x is None else x.tolist(), value, gap, nfev,
                                 time.perf_counter() - t0))
             progress(f"  budget {budget}, seed {seed}: done ({len(runs)} runs so far)")
     return runs
 
 
-def table(runs: list[Run]) -> list[dict]:
-    """One row per method and budget: median / best / worst true T_RMS, gap, share within 1 %, calls, time."""
+def table(runs: list[Run], problem: DesignProblem | None = None, truth: GroundTruth | None = None) -> list[dict]:
+    """One row per method and budget: median / best / worst true value, gap, share within 1 %, calls, time, and
+    whether the median run reached the optimum (see :func:`tolerance`)."""
+    tol = tolerance(problem, truth) if problem is not None and truth is not None else None
     rows = []
     for method in dict.fromkeys(r.method for r in runs):
         for budget in sorted({r.budget for r in runs if r.method == method}):
@@ -106,6 +138,8 @@ def table(runs: list[Run]) -> list[dict]:
                 "median_calls": float(np.median([r.nfev for r in sel])),
                 "max_calls": int(max(r.nfev for r in sel)),
                 "median_wall_s": float(np.median([r.wall_time_s for r in sel])),
+                "median_reached": bool(tol is not None and finite.sum() * 2 > len(sel)
+                                       and np.median(np.where(finite, t, np.inf)) <= truth.fun + tol),
             })
     return rows
 
@@ -167,13 +201,81 @@ def plot_gaps(rows: list[dict], path: Path) -> Path:
     return save_figure(fig, path)
 
 
+def simulations_needed(rows: list[dict]) -> dict[str, int | None]:
+    """Per method, the fewest budget after which the median run reaches the optimum (None: never, in the runs)."""
+    out: dict[str, int | None] = {}
+    for method in dict.fromkeys(r["method"] for r in rows):
+        reached = sorted(r["budget"] for r in rows if r["method"] == method and r["median_reached"])
+        out[method] = reached[0] if reached else None
+    return out
+
+
+def headline(needed: dict[str, dict[str, int | None]], budgets: dict[str, int]) -> str:
+    """Markdown table: studies (columns) × methods (rows), the simulations each needs to reach the optimum."""
+    studies = list(needed)
+    methods = list(dict.fromkeys(m for n in needed.values() for m in n))
+    lines = ["| method | " + " | ".join(studies) + " |", "|---|" + "---|" * len(studies)]
+    for m in methods:
+        cells = []
+        for st in studies:
+            v = needed[st].get(m, "—")
+            cells.append("—" if v == "—" else (f"> {budgets[st]}" if v is None else str(v)))
+        lines.append(f"| {m} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def plot_headline(needed: dict[str, dict[str, int | None]], budgets: dict[str, int], path: Path) -> Path:
+    """Simulations needed per method and study (log scale); a hollow bar: not reached within the largest budget."""
+    from mechopt.sim.figure_file import save_figure
+
+    from .plots import plt
+
+    studies = list(needed)
+    methods = list(dict.fromkeys(m for n in needed.values() for m in n))
+    fig, ax = plt.subplots(figsize=(max(8.0, 1.2 * len(methods) * len(studies) / 3 + 4), 5.2))
+    width = 0.8 / max(len(studies), 1)
+    for j, st in enumerate(studies):
+        xs, hs, hollow = [], [], []
+        for i, m in enumerate(methods):
+            v = needed[st].get(m, "—")
+            if v == "—":
+                continue
+            xs.append(i + (j - (len(studies) - 1) / 2) * width)
+            hs.append(budgets[st] * 1.5 if v is None else v)
+            hollow.append(v is None)
+        bars = ax.bar(xs, hs, width=width, label=st, color=f"C{j}")
+        for bar, h in zip(bars, hollow, strict=True):
+            if h:
+                bar.set_facecolor("none")
+                bar.set_edgecolor(f"C{j}")
+                bar.set_hatch("//")
+    ax.set_yscale("log")
+    ax.set_xticks(range(len(methods)))
+    ax.set_xticklabels(methods, rotation=35, ha="right", fontsize=8)
+    ax.set_ylabel("simulations to reach the optimum (median of the seeds)")
+    ax.set_title("Simulations each method needs to reach the optimum (hatched: not within the largest budget)",
+                 fontsize=10)
+    ax.grid(alpha=0.3, axis="y", which="both")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
 def write(runs: list[Run], truth: GroundTruth, out: Path, study: Study, seeds: int) -> tuple[Path, Path]:
     """Write compare.json, compare.md and figures/compare_gaps.png into ``out``."""
-    rows = table(runs)
+    rows = table(runs, study.problem, truth)
     out.mkdir(parents=True, exist_ok=True)
     (out / "compare.json").write_text(json.dumps({"study": study.name, "seeds": seeds, "truth": truth.__dict__,
-                                                  "rows": rows, "runs": [r.__dict__ for r in runs]}, indent=2))
+                                                  "tolerance": tolerance(study.problem, truth),
+                                                  "needed": simulations_needed(rows), "rows": rows,
+                                                  "runs": [r.__dict__ for r in runs]}, indent=2))
     md = out / "compare.md"
-    md.write_text(markdown(rows, truth, study, seeds) + "\nMedian gap to the true optimum:\n\n" + pivot_markdown(rows))
+    needed = simulations_needed(rows)
+    md.write_text(markdown(rows, truth, study, seeds)
+                  + "\nSimulations after which the median run is within "
+                  + f"{tolerance(study.problem, truth):.3g} of the optimum: "
+                  + ", ".join(f"{m} {'> ' + str(max(r['budget'] for r in rows)) if v is None else v}"
+                              for m, v in needed.items()) + "\n"
+                  + "\nMedian gap to the true optimum:\n\n" + pivot_markdown(rows))
     fig = plot_gaps(rows, out / "figures" / "compare_gaps.png")
     return md, fig

@@ -29,7 +29,7 @@ STUDIES_DIR = PACKAGED_STUDIES
 
 #: Sections the engine reads; a plug-in declares its own in :data:`PLUGIN_SECTIONS`-style checks of its own.
 ENGINE_SECTIONS = {"name", "description", "kind", "variables", "designs", "surrogate", "paper", "compare",
-                   "validation"}
+                   "validation", "simulator"}
 
 
 @dataclass(frozen=True)
@@ -87,8 +87,23 @@ class Study:
 
 
 def available_studies() -> list[str]:
-    """Names of the studies shipped with mechopt."""
-    return sorted(p.parent.name for p in STUDIES_DIR.glob("*/study.toml"))
+    """Names of the studies shipped with mechopt (and of the multimodal test functions, for ``mechopt compare``)."""
+    from .test_functions import SUITE
+
+    names = [p.parent.name.replace("_", "-") for p in STUDIES_DIR.glob("*/study.toml")]
+    return sorted(names) + sorted(SUITE)
+
+
+def _suite_study(name: str) -> Study | None:
+    """A test function of the multimodal suite as a study (no file: its problem is a class)."""
+    from . import test_functions
+
+    cls = test_functions.SUITE.get(name)
+    if cls is None:
+        return None
+    doc = (cls.__doc__ or name).strip().splitlines()[0]
+    return Study(name=name, path=Path(test_functions.__file__), description=doc, kind="test-function",
+                 problem=cls())
 
 
 def _resolve(name_or_path: str | Path) -> Path:
@@ -127,6 +142,9 @@ def load_study(name_or_path: str | Path, options: dict[str, Any] | None = None) 
     StudyError
         Unknown study, malformed TOML, or a missing / unknown / ill-typed key (the message names it).
     """
+    suite = _suite_study(str(name_or_path))
+    if suite is not None:
+        return suite
     path = _resolve(name_or_path)
     items = tuple(sorted((k, v) for k, v in (options or {}).items() if v is not None))
     return _load_cached(str(path), path.stat().st_mtime_ns, items)
@@ -153,6 +171,11 @@ def _load_cached(path_str: str, _mtime: int, options: tuple) -> Study:
         raise StudyError(f"{path.name}: missing key kind (the mechanism plug-in, e.g. kind = \"four-bar\")")
     try:
         problem = mechanism_factory(kind)(file, dict(options))
+        if "simulator" in config:
+            # A user's simulator (a command or a Python function) replaces only the plug-in's evaluator.
+            from mechopt.sim.simulators.study import with_simulator
+
+            problem = with_simulator(file, problem)
         problem.check()
     except StudyError:
         raise

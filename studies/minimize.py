@@ -25,8 +25,11 @@ from .store import SampleStore
 
 __all__ = ["METHODS", "minimize"]
 
-#: The sparse pipeline of paper 002; every name of :data:`mechopt.studies.baselines.BASELINES` is a method too.
-METHODS = ("sparse",)
+#: ``"sparse"``: the pipeline of paper 002 (global model, confirmation, local refinement) — for smooth landscapes;
+#: ``"sparse-global"``: the same lines and blend made global on multimodal ones (basins of the blend and of its
+#: leave-one-line-out uncertainty simulated, zooms, local searches; :mod:`mechopt.studies.sparse_global`).  Every
+#: name of :data:`mechopt.studies.baselines.BASELINES` is a method too.
+METHODS = ("sparse", "sparse-global")
 
 
 def _baselines() -> dict[str, Callable[..., Any]]:
@@ -47,7 +50,7 @@ def _check_arguments(problem: Any, budget: Any, method: Any, seed: Any, workers:
         raise InputError(f"seed = {seed!r}: expected a whole number >= 0")
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise InputError(f"workers = {workers!r}: expected a whole number >= 1")
-    if method == "sparse" and not 2 <= problem.dim <= 4:
+    if method in METHODS and not 2 <= problem.dim <= 4:
         raise InputError(f"the sparse method handles 2 to 4 design variables; {problem.name!r} has {problem.dim}")
 
 
@@ -119,6 +122,8 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
         sampler = Sampler(problem, db, executor, progress, retry_failed)
         if method == "sparse":
             result = _sparse(problem, opts, sampler, log)
+        elif method == "sparse-global":
+            result = _sparse_global(problem, int(budget), int(seed), sampler)
         else:
             fn = method if callable(method) else _baselines()[method]
             result = _baseline(problem, fn, int(budget), int(seed), sampler,
@@ -145,6 +150,24 @@ def _sparse(problem: DesignProblem, opts: SparseOptions, sampler: Sampler, log: 
     return OptimizeResult(x=pipeline.x, fun=pipeline.fun, nfev=nfev, success=success, message=pipeline.message,
                           method="sparse", model=pipeline.stages[0].model, stages=pipeline.stages,
                           pipeline=pipeline, validation=validation, options=opts)
+
+
+def _sparse_global(problem: DesignProblem, budget: int, seed: int, sampler: Sampler) -> OptimizeResult:
+    from .sparse_global import global_search
+
+    def evaluate(X: np.ndarray) -> np.ndarray:
+        return sampler(np.atleast_2d(X), desc="sparse-global")
+
+    def margins(X: np.ndarray) -> np.ndarray:
+        return problem.constraint_margins(np.atleast_2d(X))
+
+    res = global_search(evaluate, problem.bounds, problem.feasible, problem.sampleable, budget=budget,
+                        fit=problem.fit, seed=seed, margins=margins if problem.constraints else None)
+    success = bool(np.all(np.isfinite(res.x)) and problem.feasible(res.x)[0])
+    trust = dict(res.trust)
+    return OptimizeResult(x=np.asarray(res.x, dtype=float), fun=float(res.fun), nfev=len(sampler.designs),
+                          success=success, message=str(trust.get("verdict", "")), method="sparse-global",
+                          model=None, models=res.models, stages=[], validation=None, trust=trust)
 
 
 def _baseline(problem: DesignProblem, fn: Callable[..., Any], budget: int, seed: int, sampler: Sampler,

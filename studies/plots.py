@@ -35,7 +35,7 @@ def _slice_values(problem: DesignProblem, marks: Mapping[str, np.ndarray], n_sli
 
 
 def plot_feasible_slices(problem: DesignProblem, path: str | Path, marks: Mapping[str, np.ndarray] | None = None,
-                         n_slices: int = 4, n: int = 240) -> Path:
+                         n_slices: int = 4, n: int = 240, model=None) -> Path:
     """The feasible region with each constraint's zero contour (paper Fig. 7, 12).
 
     For d = 2 one panel of the plane; for d >= 3 slices in the plane of the last two variables at fixed values of
@@ -54,6 +54,8 @@ def plot_feasible_slices(problem: DesignProblem, path: str | Path, marks: Mappin
         Slices for d >= 3 (more when there are more marks).
     n : int
         Grid resolution per axis.
+    model : ObjectiveModel, optional
+        For d = 2, its prediction of the objective is drawn as contour lines over the feasible region.
     """
     path = figure_path(path)
     marks = dict(marks or {})
@@ -63,7 +65,8 @@ def plot_feasible_slices(problem: DesignProblem, path: str | Path, marks: Mappin
     gx, gy = np.linspace(*b[ix], n), np.linspace(*b[iy], n)
     GX, GY = np.meshgrid(gx, gy, indexing="ij")
     slices = [None] if d == 2 else _slice_values(problem, marks, n_slices)
-    fig, axes = plt.subplots(1, len(slices), figsize=(4.8 * len(slices) + 0.6, 4.9), squeeze=False)
+    width = 8.5 if d == 2 else 4.8 * len(slices) + 0.6
+    fig, axes = plt.subplots(1, len(slices), figsize=(width, 6.2 if d == 2 else 4.9), squeeze=False)
     handles: dict[str, object] = {}
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for ax, value in zip(axes[0], slices, strict=True):
@@ -73,6 +76,13 @@ def plot_feasible_slices(problem: DesignProblem, path: str | Path, marks: Mappin
         X[:, ix], X[:, iy] = GX.ravel(), GY.ravel()
         feasible = problem.feasible(X).reshape(GX.shape)
         ax.contourf(GX, GY, feasible.astype(float), levels=[0.5, 1.5], colors=["#cfe8cf"])
+        if model is not None and d == 2:
+            Z = np.where(feasible.ravel() & model.contains(X), model.predict(X), np.nan).reshape(GX.shape)
+            if np.isfinite(Z).sum() > 10:
+                levels = np.nanquantile(Z, np.linspace(0.02, 0.9, 9))
+                cs = ax.contour(GX, GY, Z, levels=np.unique(levels), colors="0.35", linewidths=0.7)
+                ax.clabel(cs, fontsize=7, fmt="%.3g")
+                handles["model"] = plt.Line2D([], [], color="0.35", lw=0.7, label=f"model {problem.objective}")
         if problem.constraints:
             M = problem.constraint_margins(X)
             for k, name in enumerate(problem.constraints):
@@ -96,11 +106,13 @@ def plot_feasible_slices(problem: DesignProblem, path: str | Path, marks: Mappin
             ax.set_title(f"{v[0].label or v[0].name} = {value:.4g} {v[0].unit}".strip(), fontsize=10)
         ax.grid(alpha=0.25)
     handles["feasible"] = plt.Rectangle((0, 0), 1, 1, color="#cfe8cf", label="feasible")
-    fig.legend(handles=list(handles.values()), fontsize=8, loc="lower center", ncol=min(len(handles), 6),
-               frameon=False)
+    ncol = min(len(handles), 3 if d == 2 else 6)
+    fig.legend(handles=list(handles.values()), fontsize=8, loc="lower center", ncol=ncol, frameon=False)
     what = "the design space" if d == 2 else f"slices at fixed {problem.variables[0].label or problem.names[0]}"
-    fig.suptitle(f"Feasible designs of '{problem.name}' ({what}), each constraint's boundary", fontsize=11)
-    fig.tight_layout(rect=(0, 0.08, 1, 1))
+    fig.suptitle(f"Feasible designs of '{problem.name}' ({what}),\neach constraint's boundary"
+                 + (" and the model's contours" if model is not None and d == 2 else ""), fontsize=11)
+    rows = -(-len(handles) // ncol)
+    fig.tight_layout(rect=(0, 0.03 + 0.035 * rows, 1, 1))
     return save_figure(fig, path)
 
 

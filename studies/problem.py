@@ -132,6 +132,8 @@ class DesignProblem:
         The output minimised.
     fit : str
         ``"square"`` (the model fits the objective squared, as T_RMS² for an RMS torque) or ``"value"``.
+    output_units : dict
+        Unit of each output, for reports and axis labels (``{"t_rms": "N·m"}``).
     version : int
         Bump it when :meth:`evaluate` changes in a way :meth:`settings` does not show, so that stored samples of
         the old code are not reused.
@@ -146,6 +148,7 @@ class DesignProblem:
     outputs: tuple[str, ...] = ()
     objective: str = ""
     fit: str = "value"
+    output_units: dict[str, str] = {}  # noqa: RUF012 - read-only class default
     version: int = 1
     surrogate_order: tuple[int, ...] | None = None
 
@@ -280,6 +283,11 @@ class DesignProblem:
         if len(self.constraints) and ok.any():
             ok[ok] = np.all(self.constraint_margins(X[ok]) >= 0.0, axis=1)
         return ok
+
+    def output_label(self, name: str) -> str:
+        """``name (unit)`` of an output, for tables and axes."""
+        unit = dict(self.output_units).get(name, "")
+        return f"{name} ({unit})" if unit else name
 
     def objective_value(self, outputs: Mapping[str, float]) -> float:
         """The objective from an evaluation's outputs."""

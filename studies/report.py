@@ -26,7 +26,7 @@ def _figures(run) -> dict[str, str]:
     designs["optimum"] = np.asarray(run.result.x)
     files.update(problem.figures(designs, fig_dir))
     files["Feasible region and each constraint's boundary"] = plot_feasible_slices(
-        problem, fig_dir / "feasible_region.png", marks=marks)
+        problem, fig_dir / "feasible_region.png", marks=marks, model=stage.model)
     if problem.dim == 3:
         ends = stage.model.from_u(stage.plan.segment_ends().reshape(-1, 3))
         files["Feasible region, sampling lines and their hull"] = plot_feasible_3d(
@@ -80,7 +80,8 @@ def result_dict(run) -> dict[str, Any]:
         "message": res.message,
         "validation": None if val is None else {
             "rmse": val.rmse, "rmse_low": val.rmse_low, "max_error": val.max_error, "f_min": val.f_min,
-            "rmse_pct_of_f_min": val.rmse_pct, "n_points": val.n_points, "n_lines": len(val.lines)},
+            "rmse_pct_of_f_min": val.rmse_pct, "rmse_pct_of_range": val.rmse_pct_of_range, "range": val.spread,
+            "relative": val.relative_text(), "n_points": val.n_points, "n_lines": len(val.lines)},
         "ground_truth": None if run.truth is None else {
             "design": problem.design_dict(run.truth.x), "objective": run.truth.fun, "grid_step": run.truth.step,
             "gap_pct": 100 * (res.fun / run.truth.fun - 1) if run.truth.fun else None},
@@ -105,7 +106,7 @@ def write_outputs(run) -> None:
 
 
 def _fmt(value: Any) -> str:
-    return f"{value:.4g}" if isinstance(value, int | float) else "—"
+    return f"{value:.4g}" if isinstance(value, int | float) and np.isfinite(value) else "—"
 
 
 def report_markdown(r: dict[str, Any], study) -> str:
@@ -118,8 +119,8 @@ def report_markdown(r: dict[str, Any], study) -> str:
     s = r["simulations"]
     paper = r["paper"] or {}
     lines = [f"# Study `{r['study']}`", "", study.description, "",
-             f"**Optimum**: {problem.describe(np.array([o['design'][n] for n in names]))} — {obj} "
-             f"{o['objective']:.6g} (model {o['predicted']:.6g}).", "",
+             f"**Optimum**: {problem.describe(np.array([o['design'][n] for n in names]))} — "
+             f"{problem.output_label(obj)} {o['objective']:.6g} (model {o['predicted']:.6g}).", "",
              f"Simulations: {s['model_lines']} on the lines of the global model"
              + (f" (paper: {paper['fit_simulations']})" if "fit_simulations" in paper else "")
              + f", {s['optimisation'] - s['model_lines']} more to confirm and refine its candidate, {s['validation']} "
@@ -128,17 +129,27 @@ def report_markdown(r: dict[str, Any], study) -> str:
              + f", {s['references']} for the reference designs. Of these, {s['new']} were simulated by this run, "
              f"{s['reused']} reused from the store, {s['waited_for_other_runs']} computed by another run on the same "
              f"store, and {s['failed']} failed. Executor: {s['executor']}.", "",
-             "## Designs", "",
-             "| design | " + " | ".join(f"{n} ({units[n]})" for n in names) + f" | {obj} | savings | paper "
-             f"{obj} | feasible |",
-             "|---" * (len(names) + 5) + "|"]
+             "## Designs", ""]
+    outputs = list(problem.outputs)
+    papers = sorted({k for row in r["designs"] for k in row["paper"]})
+    lines += ["| design | " + " | ".join(f"{n} ({units[n]})" if units[n] else n for n in names) + " | "
+              + " | ".join(problem.output_label(k) for k in outputs) + f" | {obj} savings | "
+              + "".join(f"{k} | " for k in papers) + "feasible |",
+              "|---" * (len(names) + len(outputs) + len(papers) + 3) + "|"]
     for row in r["designs"]:
-        value = row["outputs"].get(obj) if row["status"] == "ok" else None
-        paper_fig = next(iter(row["paper"].values()), None)
-        lines.append(f"| {row['name']} | " + " | ".join(f"{row['design'][n]:.4f}" for n in names)
-                     + f" | {_fmt(value) if value is not None else row['status']} | "
-                     + (f"{row['savings_pct']:.1f} %" if "savings_pct" in row else "—")
-                     + f" | {_fmt(paper_fig)} | {'yes' if row['feasible'] else 'no'} |")
+        values = [(_fmt(row["outputs"].get(k)) if row["status"] == "ok" else row["status"]) for k in outputs]
+        lines.append(f"| {row['name']} | " + " | ".join(f"{row['design'][n]:.4f}" for n in names) + " | "
+                     + " | ".join(values) + " | "
+                     + (f"{row['savings_pct']:.1f} %" if "savings_pct" in row else "—") + " | "
+                     + "".join(f"{_fmt(row['paper'].get(k))} | " for k in papers)
+                     + f"{'yes' if row['feasible'] else 'no'} |")
+    if papers:
+        lines += ["", "The paper_* columns are the paper's own figures for the same designs (its model, not ours): "
+                  "compare savings, not absolute values, where the models differ."]
+    if r["failures"]:
+        lines += ["", f"## Failed simulations ({len(r['failures'])})", "", "| design | error |", "|---|---|"]
+        lines += [f"| {problem.describe(np.array([f['design'][n] for n in names]))} | {f['error']} |"
+                  for f in r["failures"][:50]]
     g = r["ground_truth"]
     if g:
         lines += ["", "## Against the ground truth", "",
@@ -149,9 +160,8 @@ def report_markdown(r: dict[str, Any], study) -> str:
     if v:
         lines += ["", "## Validation", "",
                   f"{v['n_points']} held-out simulations on {v['n_lines']} lines in other directions than the model's "
-                  f"own, inside its hull: RMSE {v['rmse']:.4g} ({v['rmse_pct_of_f_min']:.2f} % of the best simulated "
-                  f"{obj}, {v['f_min']:.4g}), {v['rmse_low']:.4g} where {obj} <= 2 × that minimum, max error "
-                  f"{v['max_error']:.4g}."
+                  f"own, inside its hull: RMSE {v['rmse']:.4g} ({v['relative']}), {_fmt(v['rmse_low'])} where {obj} "
+                  f"<= 2 × the best simulated value, max error {v['max_error']:.4g}."
                   + (f" The paper: RMSE {paper['validation_rmse']}" if "validation_rmse" in paper else "")
                   + (f", {paper['validation_rmse_low']} below {paper.get('validation_rmse_low_below')}"
                      if "validation_rmse_low" in paper else "") + "."]

@@ -135,8 +135,7 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
                                   options.validation_points, options.seed, f_min=pipeline.fun)
             timings["validation_s"] = time.perf_counter() - t0
             log(f"  validation: {validation.n_points} held-out simulations on {len(validation.lines)} lines, RMSE "
-                f"{validation.rmse:.4g} ({validation.rmse_pct:.2f} % of the best {validation.f_min:.4g}), max "
-                f"{validation.max_error:.4g}")
+                f"{validation.rmse:.4g} ({validation.relative_text()}), max {validation.max_error:.4g}")
         n_val = len(sampler.designs) - n_opt
         pipeline.stages[0].model.save(out / "model.json")
         t0 = time.perf_counter()

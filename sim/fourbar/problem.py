@@ -66,6 +66,7 @@ class FourBarProblem(DesignProblem):
     outputs = ("t_rms", "t_max")
     objective = "t_rms"
     fit = "square"
+    output_units = {"t_rms": "N·m", "t_max": "N·m"}  # noqa: RUF012
     # Paper 002 plans its lines over (|OA|, |BC|, |AB|): its Δ and origin are read in as printed.
     surrogate_order = (0, 2, 1)
 

@@ -44,8 +44,13 @@ def refine_locally(space: ModelSpace, sampler: Sampler, x0: np.ndarray, budget: 
         ``candidate`` the best feasible design simulated, ``n_samples`` the simulations it took.
     """
 
+    square = model_stage.model.fit == "square"
+
     def objective(x: np.ndarray) -> float:
-        return float(sampler(np.asarray(x, dtype=float)[None, :], desc="refinement")[0])
+        # The square of a non-negative objective has the same minimiser and no kink at a zero (a synthesis that can
+        # reach its target exactly); it is what the model was fitted to.
+        value = float(sampler(np.asarray(x, dtype=float)[None, :], desc="refinement")[0])
+        return value * value if square else value
 
     progress, sampler.progress = sampler.progress, False
     t0 = time.perf_counter()

@@ -27,6 +27,8 @@ class Validation:
         The reference minimum the relative figures use: the best simulated design of the run.
     n_points : int
         Held-out simulations that succeeded.
+    spread : float
+        Range (max − min) of the held-out simulations: the scale of an objective whose minimum is 0.
     """
 
     lines: list[dict]
@@ -35,15 +37,27 @@ class Validation:
     max_error: float
     f_min: float
     n_points: int
+    spread: float = float("nan")
 
     @property
     def rmse_pct(self) -> float:
         """RMSE as a percentage of |f_min| (NaN when there is no point or f_min is 0)."""
         return 100 * self.rmse / abs(self.f_min) if self.n_points and self.f_min else float("nan")
 
+    @property
+    def rmse_pct_of_range(self) -> float:
+        """RMSE as a percentage of the held-out values' range."""
+        return 100 * self.rmse / self.spread if self.n_points and self.spread > 0 else float("nan")
+
+    def relative_text(self) -> str:
+        """The RMSE relative to the scale that means something: f_min, or the range when f_min is (near) 0."""
+        if self.f_min and abs(self.f_min) > 1e-3 * self.spread:
+            return f"{self.rmse_pct:.2f} % of the best simulated value {self.f_min:.4g}"
+        return f"{self.rmse_pct_of_range:.2f} % of the held-out values' range {self.spread:.4g}"
+
     def summary(self) -> dict:
         """JSON-able summary (lines with their points)."""
-        return {**asdict(self), "rmse_pct_of_f_min": self.rmse_pct}
+        return {**asdict(self), "rmse_pct_of_f_min": self.rmse_pct, "rmse_pct_of_range": self.rmse_pct_of_range}
 
 
 def validation_lines(model: ObjectiveModel, space: ModelSpace, n_lines: int, n_points: int,
@@ -112,4 +126,5 @@ def validate(model: ObjectiveModel, space: ModelSpace, sampler: Sampler, n_lines
         max_error=float(np.max(np.abs(err))) if err.size else nan,
         f_min=float(f_min),
         n_points=int(sim.size),
+        spread=float(np.ptp(sim)) if sim.size else nan,
     )

@@ -1,0 +1,237 @@
+"""Multimodal test functions as design problems: the suite on which the global strategy is measured.
+
+Each problem is a :class:`~mechopt.studies.problem.DesignProblem` with its known global minimum ``f_min``, every
+global minimiser ``x_min`` (one row per minimiser: Branin and the six-hump camel have several), the value of the
+second-best local minimum ``f_second`` and the range of the function over the (feasible) box, ``f_range`` = max − min,
+measured once on a dense grid (:func:`dense_grid_range` with the grid recorded in ``range_grid``; the printed
+constants below are max − ``f_min`` from that function's output, to 5 significant digits).
+
+:meth:`TestFunction.in_global_basin` decides whether a design lies in the basin of a global minimiser: a local
+descent on the function itself (L-BFGS-B in the box, SLSQP when there are constraints) started there must end at one
+of the ``x_min``.  ``gap`` is (f(x) − f_min) / f_range, the measure of the benchmarks.
+
+References: Dixon & Szegő (1978) for Hartmann-3, Branin and the six-hump camel; Himmelblau (1972); the cosine
+function is issue 15's (a quadratic bowl with a product of cosines, 31 local minima in [0, 1]^3).
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import numpy as np
+from scipy.optimize import minimize
+
+from .problem import DesignProblem, Variable
+
+__all__ = [
+    "SUITE",
+    "Branin",
+    "CosineBowl3",
+    "Hartmann3",
+    "HimmelblauDisc",
+    "SixHumpCamel",
+    "TestFunction",
+    "dense_grid_range",
+]
+
+
+class TestFunction(DesignProblem):
+    """A design problem with a vectorised closed form and known minima.
+
+    Attributes
+    ----------
+    f_min : float
+        Global minimum over the feasible box.
+    x_min : (k, d) ndarray
+        Every global minimiser.
+    f_second : float
+        Value of the best local minimum that is not global (for reports).
+    f_range : float
+        max − min of the function over the feasible box (dense grid, see :func:`dense_grid_range`).
+    range_grid : int
+        Points per axis of the grid that measured ``f_range``.
+    """
+
+    __test__ = False  # not a pytest class despite the name
+    outputs = ("f",)
+    objective = "f"
+    fit = "value"
+    f_min: ClassVar[float] = np.nan
+    x_min: ClassVar[np.ndarray] = np.zeros((0, 0))
+    f_second: ClassVar[float] = np.nan
+    f_range: ClassVar[float] = np.nan
+    range_grid: ClassVar[int] = 0
+
+    def function(self, X: np.ndarray) -> np.ndarray:
+        """The function at designs X (n, d), shape (n,)."""
+        raise NotImplementedError
+
+    def __call__(self, X: np.ndarray) -> np.ndarray:
+        """Batch evaluator: f at designs (n, d), shape (n,)."""
+        return self.function(np.atleast_2d(np.asarray(X, dtype=float)))
+
+    def evaluate(self, x: np.ndarray) -> dict[str, float]:
+        """The function at one design (d,), as ``{"f": value}``."""
+        return {"f": float(self(np.asarray(x, dtype=float)[None, :])[0])}
+
+    def sampleable(self, X: np.ndarray) -> np.ndarray:
+        """The closed form is defined on the whole box: lines may cross a constraint but not a bound."""
+        return self.in_box(X)
+
+    def gap(self, fun: float) -> float:
+        """(fun − f_min) / f_range, the fraction of the function's range by which ``fun`` misses the minimum."""
+        return (float(fun) - self.f_min) / self.f_range
+
+    def in_global_basin(self, x: np.ndarray, tol: float = 1e-2) -> bool:
+        """Whether a local descent on the function from ``x`` ends at a global minimiser.
+
+        Parameters
+        ----------
+        x : (d,) ndarray
+            Design.
+        tol : float
+            Largest distance of the descent's end from a minimiser, as a fraction of the box's largest width.
+        """
+        b = self.bounds
+        x = np.clip(np.asarray(x, dtype=float), b[:, 0], b[:, 1])
+        width = b[:, 1] - b[:, 0]
+
+        def fun(u: np.ndarray) -> float:
+            return float(self(b[:, 0] + u * width)[0])
+
+        u0 = (x - b[:, 0]) / width
+        if self.constraints:
+            cons = [{"type": "ineq", "fun": lambda u: self.margins((b[:, 0] + u * width)[None, :])[0]}]
+            res = minimize(fun, u0, method="SLSQP", bounds=[(0, 1)] * self.dim, constraints=cons,
+                           options={"ftol": 1e-12, "maxiter": 500})
+        else:
+            res = minimize(fun, u0, method="L-BFGS-B", bounds=[(0, 1)] * self.dim,
+                           options={"ftol": 1e-14, "gtol": 1e-10})
+        end = b[:, 0] + res.x * width
+        return bool(np.min(np.linalg.norm(self.x_min - end, axis=1)) <= tol * width.max())
+
+
+def dense_grid_range(problem: TestFunction, n: int) -> tuple[float, float]:
+    """Smallest and largest value of the function on the feasible points of an n^d tensor grid of the box.
+
+    Parameters
+    ----------
+    problem : TestFunction
+    n : int
+        Points per axis (both bounds included).
+
+    Returns
+    -------
+    (float, float)
+        min and max over the feasible grid points.
+    """
+    axes = [np.linspace(v.lower, v.upper, n) for v in problem.variables]
+    lo, hi = np.inf, -np.inf
+    # Chunk over the first axis so a 400^3 grid does not need 64 million rows at once.
+    for a in axes[0]:
+        rest = np.stack(np.meshgrid(*axes[1:], indexing="ij"), axis=-1).reshape(-1, problem.dim - 1)
+        X = np.column_stack([np.full(rest.shape[0], a), rest])
+        X = X[problem.feasible(X)]
+        if X.shape[0]:
+            f = problem(X)
+            lo, hi = min(lo, float(f.min())), max(hi, float(f.max()))
+    return lo, hi
+
+
+class Hartmann3(TestFunction):
+    """Hartmann-3 on [0, 1]^3: four local minima, global −3.86278 at (0.114614, 0.555649, 0.852547)."""
+
+    name = "hartmann3"
+    variables = (Variable("x1", 0.0, 1.0), Variable("x2", 0.0, 1.0), Variable("x3", 0.0, 1.0))
+    f_min = -3.86278214782076
+    x_min = np.array([[0.114614, 0.555649, 0.852547]])
+    f_second = -3.08976
+    f_range = 3.8628  # dense_grid_range(Hartmann3(), 201): max −3.8e-5 (a corner) minus f_min
+    range_grid = 201
+
+    _A = np.array([[3.0, 10, 30], [0.1, 10, 35], [3.0, 10, 30], [0.1, 10, 35]])
+    _C = np.array([1.0, 1.2, 3.0, 3.2])
+    _P = 1e-4 * np.array([[3689, 1170, 2673], [4699, 4387, 7470], [1091, 8732, 5547], [381, 5743, 8828]])
+
+    def function(self, X: np.ndarray) -> np.ndarray:
+        inner = np.einsum("jk,njk->nj", self._A, (X[:, None, :] - self._P[None, :, :]) ** 2)
+        return -np.exp(-inner) @ self._C
+
+
+class CosineBowl3(TestFunction):
+    """Σ (x − 0.3)² − 0.3 Π cos(3π (x − 0.3)) on [0, 1]^3: 31 local minima, global −0.3 at (0.3, 0.3, 0.3)."""
+
+    name = "cosine_bowl3"
+    variables = (Variable("x1", 0.0, 1.0), Variable("x2", 0.0, 1.0), Variable("x3", 0.0, 1.0))
+    f_min = -0.3
+    x_min = np.array([[0.3, 0.3, 0.3]])
+    f_second = -0.0937
+    f_range = 1.6726  # dense_grid_range(CosineBowl3(), 201): max 1.37258 minus f_min
+    range_grid = 201
+
+    def function(self, X: np.ndarray) -> np.ndarray:
+        t = X - 0.3
+        return np.sum(t * t, axis=1) - 0.3 * np.prod(np.cos(3.0 * np.pi * t), axis=1)
+
+
+class Branin(TestFunction):
+    """Branin on [−5, 10] × [0, 15]: three global minima 0.397887 (−π, 12.275), (π, 2.275), (9.42478, 2.475)."""
+
+    name = "branin"
+    variables = (Variable("x1", -5.0, 10.0), Variable("x2", 0.0, 15.0))
+    f_min = 0.39788735772973816
+    x_min = np.array([[-np.pi, 12.275], [np.pi, 2.275], [3 * np.pi, 2.475]])
+    f_second = np.nan  # all three minima are global
+    f_range = 307.73  # dense_grid_range(Branin(), 1501): max 308.1291 at (−5, 0) minus f_min
+    range_grid = 1501
+
+    def function(self, X: np.ndarray) -> np.ndarray:
+        x1, x2 = X[:, 0], X[:, 1]
+        b, c = 5.1 / (4 * np.pi**2), 5 / np.pi
+        return (x2 - b * x1**2 + c * x1 - 6) ** 2 + 10 * (1 - 1 / (8 * np.pi)) * np.cos(x1) + 10
+
+
+class SixHumpCamel(TestFunction):
+    """Six-hump camel on [−3, 3] × [−2, 2]: six local minima, global −1.031628 at ±(0.089842, −0.712656)."""
+
+    name = "six_hump_camel"
+    variables = (Variable("x1", -3.0, 3.0), Variable("x2", -2.0, 2.0))
+    f_min = -1.0316284534898774
+    x_min = np.array([[0.0898420131, -0.7126564030], [-0.0898420131, 0.7126564030]])
+    f_second = -0.215464
+    f_range = 163.93  # dense_grid_range(SixHumpCamel(), 1501): max 162.9 at (±3, ±2) minus f_min
+    range_grid = 1501
+
+    def function(self, X: np.ndarray) -> np.ndarray:
+        x1, x2 = X[:, 0], X[:, 1]
+        return (4 - 2.1 * x1**2 + x1**4 / 3) * x1**2 + x1 * x2 + (-4 + 4 * x2**2) * x2**2
+
+
+class HimmelblauDisc(TestFunction):
+    """Himmelblau on [−5, 5]^2 with the margin 4.5 − |x| >= 0 (a disc): of its four minima (value 0), the one at
+    (−3.779, −3.283) lies outside the disc; the other three are the global minima.
+    """
+
+    name = "himmelblau_disc"
+    variables = (Variable("x1", -5.0, 5.0), Variable("x2", -5.0, 5.0))
+    constraints = ("disc",)
+    f_min = 0.0
+    x_min = np.array([[3.0, 2.0], [-2.805118, 3.131312], [3.584428, -1.848126]])
+    f_second = 8.3653  # constrained local minimum on the disc near (−3.444, −2.896), by SLSQP on the disc
+    f_range = 418.63  # dense_grid_range(HimmelblauDisc(), 1501): max 418.628 on the disc, minus f_min
+    range_grid = 1501
+    radius = 4.5
+
+    def margins(self, X: np.ndarray) -> np.ndarray:
+        return (self.radius - np.hypot(X[:, 0], X[:, 1]))[:, None]
+
+    def function(self, X: np.ndarray) -> np.ndarray:
+        x1, x2 = X[:, 0], X[:, 1]
+        return (x1**2 + x2 - 11) ** 2 + (x1 + x2**2 - 7) ** 2
+
+
+#: The benchmark suite, by name.
+SUITE: dict[str, type[TestFunction]] = {
+    cls.name: cls for cls in (Hartmann3, CosineBowl3, Branin, SixHumpCamel, HimmelblauDisc)
+}
+

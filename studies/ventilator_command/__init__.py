@@ -1,0 +1,1 @@
+"""The ventilator study with its simulator run as an external program (a stand-in for a CAD batch run)."""
