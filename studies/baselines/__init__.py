@@ -5,6 +5,11 @@ OptimizeResult`` and returns the best *feasible* design it simulated (``x``, ``f
 calls used (``nfev <= problem.budget``); :class:`~studies.baselines.problem.CountedProblem` enforces the budget.
 :func:`~studies.baselines.rbf_surrogate.fit_and_search_rbf` is the surrogate baseline fed with given samples; it is
 not in :data:`BASELINES` because it does not choose its own samples.
+
+:data:`BASELINES` holds the in-house implementations (:data:`IN_HOUSE_BASELINES`) and wrappers of maintained optimizer
+libraries (:data:`LIBRARY_BASELINES`: Optuna, SMT, pymoo, nevergrad).  The libraries are the optional ``compare``
+extra, imported only when their baseline runs; a missing one raises
+:class:`~studies.baselines.library.MissingLibraryError` with a one-line message.
 """
 
 from __future__ import annotations
@@ -17,33 +22,49 @@ from .bayesian import minimize_bayesian
 from .differential_evolution import minimize_differential_evolution
 from .dual_annealing import minimize_dual_annealing
 from .genetic import minimize_genetic
+from .library import MissingLibraryError
 from .nelder_mead import minimize_nelder_mead
+from .nevergrad_optimizers import minimize_nevergrad_cma, minimize_nevergrad_ngopt
+from .optuna_samplers import minimize_optuna_cmaes, minimize_optuna_tpe
 from .particle_swarm import minimize_particle_swarm
 from .powell_penalty import minimize_powell_penalty
 from .problem import BudgetExhausted, CountedProblem
+from .pymoo_algorithms import minimize_pymoo_de, minimize_pymoo_ga, minimize_pymoo_pso
 from .rbf_surrogate import fit_and_search_rbf
 from .sce_ua import minimize_sce_ua
 from .slsqp import minimize_slsqp
+from .smt_ego import minimize_smt_ego
 
 __all__ = [
     "BASELINES",
     "BASELINE_DOCS",
     "BudgetExhausted",
     "CountedProblem",
+    "IN_HOUSE_BASELINES",
+    "LIBRARY_BASELINES",
+    "MissingLibraryError",
     "fit_and_search_rbf",
     "minimize_bayesian",
     "minimize_differential_evolution",
     "minimize_dual_annealing",
     "minimize_genetic",
     "minimize_nelder_mead",
+    "minimize_nevergrad_cma",
+    "minimize_nevergrad_ngopt",
+    "minimize_optuna_cmaes",
+    "minimize_optuna_tpe",
     "minimize_particle_swarm",
     "minimize_powell_penalty",
+    "minimize_pymoo_de",
+    "minimize_pymoo_ga",
+    "minimize_pymoo_pso",
     "minimize_sce_ua",
     "minimize_slsqp",
+    "minimize_smt_ego",
 ]
 
-#: Short name -> baseline with the common signature ``f(problem, seed, **options) -> OptimizeResult``.
-BASELINES: dict[str, Callable[..., OptimizeResult]] = {
+#: In-house implementations: short name -> baseline ``f(problem, seed, **options) -> OptimizeResult``.
+IN_HOUSE_BASELINES: dict[str, Callable[..., OptimizeResult]] = {
     "differential_evolution": minimize_differential_evolution,
     "dual_annealing": minimize_dual_annealing,
     "nelder_mead": minimize_nelder_mead,
@@ -54,6 +75,21 @@ BASELINES: dict[str, Callable[..., OptimizeResult]] = {
     "particle_swarm": minimize_particle_swarm,
     "bayesian": minimize_bayesian,
 }
+
+#: Maintained libraries (the optional ``compare`` extra), same signature and budget accounting.
+LIBRARY_BASELINES: dict[str, Callable[..., OptimizeResult]] = {
+    "optuna_tpe": minimize_optuna_tpe,
+    "optuna_cmaes": minimize_optuna_cmaes,
+    "smt_ego": minimize_smt_ego,
+    "pymoo_ga": minimize_pymoo_ga,
+    "pymoo_pso": minimize_pymoo_pso,
+    "pymoo_de": minimize_pymoo_de,
+    "nevergrad_ngopt": minimize_nevergrad_ngopt,
+    "nevergrad_cma": minimize_nevergrad_cma,
+}
+
+#: Short name -> baseline with the common signature ``f(problem, seed, **options) -> OptimizeResult``.
+BASELINES: dict[str, Callable[..., OptimizeResult]] = {**IN_HOUSE_BASELINES, **LIBRARY_BASELINES}
 
 #: Short name -> one-line description with the reference and the constraint scheme.
 BASELINE_DOCS: dict[str, str] = {
@@ -75,4 +111,20 @@ BASELINE_DOCS: dict[str, str] = {
     "feasibility-preserving rejection (Hu & Eberhart 2002).",
     "bayesian": "Bayesian optimisation, Matérn-5/2 GP with ML-II hyperparameters and expected improvement "
     "(Jones, Schonlau & Welch 1998); infeasible candidates rejected before simulation.",
+    "optuna_tpe": "Optuna's multivariate TPE (Bergstra et al. 2011), ask/tell; Optuna's constrained TPE "
+    "(trial.set_constraint), infeasible trials told as pruned, never simulated.",
+    "optuna_cmaes": "Optuna's CMA-ES sampler (Hansen & Ostermeier 2001), ask/tell; it ignores constraints: "
+    "infeasible trials not simulated, told a penalty above every simulated value.",
+    "smt_ego": "SMT's EGO, Matérn-5/2 Kriging + expected improvement (Jones et al. 1998); infill maximises EI "
+    "under the margins (SLSQP), only feasible designs simulated.",
+    "pymoo_ga": "pymoo GA, SBX + polynomial mutation, elitist survival (Deb 2001); feasibility-first tournament "
+    "and survival (Deb 2000), infeasible designs not simulated.",
+    "pymoo_pso": "pymoo adaptive PSO (Zhan et al. 2009); feasibility-first personal/global bests, infeasible "
+    "designs not simulated.",
+    "pymoo_de": "pymoo DE/best/1/bin, F 0.5, CR 0.9 (Storn & Price 1997); feasibility-first replacement, "
+    "infeasible designs not simulated.",
+    "nevergrad_ngopt": "nevergrad's recommended NGOpt wizard (COBYLA at 3 variables and <= 150 calls); "
+    "nevergrad's cheap-constraint resampling, leftovers penalised, not simulated.",
+    "nevergrad_cma": "nevergrad's CMA-ES (pycma); nevergrad's cheap-constraint resampling, leftovers penalised, "
+    "not simulated.",
 }

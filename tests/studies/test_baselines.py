@@ -18,7 +18,8 @@ import pytest
 from scipy.optimize import check_grad
 from scipy.spatial import Delaunay
 
-from mechopt.studies.baselines import BASELINE_DOCS, BASELINES, BudgetExhausted, CountedProblem, fit_and_search_rbf
+from mechopt.studies.baselines import BASELINE_DOCS, BudgetExhausted, CountedProblem, fit_and_search_rbf
+from mechopt.studies.baselines import IN_HOUSE_BASELINES as BASELINES
 from mechopt.studies.baselines.bayesian import GaussianProcess, expected_improvement
 from mechopt.studies.baselines.genetic import polynomial_mutation, sbx_crossover
 from mechopt.studies.baselines.powell_penalty import minimize_powell_penalty
@@ -116,7 +117,7 @@ def test_registry_lists_the_nine_baselines_with_docs() -> None:
     expected = {"differential_evolution", "dual_annealing", "nelder_mead", "slsqp", "powell_penalty", "genetic",
                 "sce_ua", "particle_swarm", "bayesian"}
     assert set(BASELINES) == expected
-    assert set(BASELINE_DOCS) == expected
+    assert expected <= set(BASELINE_DOCS)  # the library baselines are documented there too
     assert set(QUAD_CASES) == expected
 
 
