@@ -99,7 +99,7 @@ def compare(study: Study, truth: GroundTruth, budgets: list[int], seeds: int, me
     for budget in budgets:
         for seed in range(seeds):
             for name in names:
-                if (name == "bayesian" and budget > BAYESIAN_MAX_BUDGET) or (name == "smt_ego" and budget > EGO_MAX_BUDGET):
+                if budget > {"bayesian": BAYESIAN_MAX_BUDGET, "smt_ego": EGO_MAX_BUDGET}.get(name, budget):
                     continue
                 t0 = time.perf_counter()
                 try:
