@@ -313,7 +313,7 @@ def _cmd_compare(args: argparse.Namespace, rest: list[str]) -> int:
     needed, budgets = {}, {}
     for study in studies:
         out = check_output_folder(base if len(studies) == 1 else base / study.name)
-        truth = cmp.known_truth(study.problem)
+        truth = cmp.known_truth(study.problem) or cmp.declared_truth(study)
         if truth is None:
             print(f"ground truth of {study.name} (brute force, grid {args.truth_grid:g}; cached in {out})")
             truth = load_or_compute(study.problem, out / f"ground_truth_{args.truth_grid:g}.json", args.truth_grid)

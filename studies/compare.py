@@ -66,6 +66,22 @@ def known_truth(problem: DesignProblem) -> GroundTruth | None:
                        n_evaluated=0, n_feasible=0, wall_time_s=0.0, key="known")
 
 
+def declared_truth(study: Study) -> GroundTruth | None:
+    """The optimum a study file declares in ``[compare] known_optimum`` (a brute force recorded with the study),
+    simulated here so that the score's reference is this engine's own value."""
+    known = study.section("compare").get("known_optimum")
+    if not isinstance(known, dict):
+        return None
+    problem = study.problem
+    try:
+        x = np.array([float(known[v]) for v in problem.names])
+    except (KeyError, TypeError, ValueError):
+        raise InputError(f"{study.name}: [compare] known_optimum must give {list(problem.names)}") from None
+    fun = float(problem.evaluate(x)[problem.objective])
+    return GroundTruth(x=x.tolist(), fun=fun, grid_x=x.tolist(), grid_fun=fun, step=0.0, n_evaluated=0,
+                       n_feasible=0, wall_time_s=0.0, key="declared")
+
+
 def tolerance(problem: DesignProblem, truth: GroundTruth) -> float:
     """How close to the optimum counts as reaching it: 0.5 % of the function's range over the box where the problem
     declares it (test functions), 0.5 % of the optimum, or 1e-6 absolute where the optimum is 0."""

@@ -2,7 +2,7 @@
 
 Every baseline has the signature ``minimize_<name>(problem: CountedProblem, seed: int, **options) ->
 OptimizeResult`` and returns the best *feasible* design it simulated (``x``, ``fun``) with the number of simulator
-calls used (``nfev <= problem.budget``); :class:`~studies.baselines.problem.CountedProblem` enforces the budget.
+calls used (``nfev <= problem.budget``); :class:`~mechopt.studies.budget.CountedProblem` enforces the budget.
 :func:`~studies.baselines.rbf_surrogate.fit_and_search_rbf` is the surrogate baseline fed with given samples; it is
 not in :data:`BASELINES` because it does not choose its own samples.
 
@@ -18,6 +18,7 @@ from collections.abc import Callable
 
 from scipy.optimize import OptimizeResult
 
+from ..budget import BudgetExhausted, CountedProblem
 from .bayesian import minimize_bayesian
 from .differential_evolution import minimize_differential_evolution
 from .dual_annealing import minimize_dual_annealing
@@ -28,7 +29,6 @@ from .nevergrad_optimizers import minimize_nevergrad_cma, minimize_nevergrad_ngo
 from .optuna_samplers import minimize_optuna_cmaes, minimize_optuna_tpe
 from .particle_swarm import minimize_particle_swarm
 from .powell_penalty import minimize_powell_penalty
-from .problem import BudgetExhausted, CountedProblem
 from .pymoo_algorithms import minimize_pymoo_de, minimize_pymoo_ga, minimize_pymoo_pso
 from .rbf_surrogate import fit_and_search_rbf
 from .sce_ua import minimize_sce_ua

@@ -21,7 +21,7 @@ from scipy.linalg import cho_factor, cho_solve, solve_triangular
 from scipy.optimize import OptimizeResult, minimize
 from scipy.special import ndtr
 
-from .problem import BudgetExhausted, CountedProblem
+from ..budget import BudgetExhausted, CountedProblem
 
 __all__ = ["GaussianProcess", "expected_improvement", "minimize_bayesian"]
 

@@ -12,7 +12,7 @@ import math
 import numpy as np
 from scipy.optimize import NonlinearConstraint, OptimizeResult, differential_evolution
 
-from .problem import BudgetExhausted, CountedProblem
+from ..budget import BudgetExhausted, CountedProblem
 
 __all__ = ["minimize_differential_evolution"]
 

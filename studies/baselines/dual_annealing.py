@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import OptimizeResult, dual_annealing
 
+from ..budget import BudgetExhausted, CountedProblem
 from ..sparse.local_search import feasible_side_gradient
-from .problem import BudgetExhausted, CountedProblem
 
 __all__ = ["minimize_dual_annealing"]
 

@@ -20,9 +20,9 @@ import numpy as np
 from scipy.optimize import OptimizeResult
 from scipy.stats import qmc
 
+from ..budget import BudgetExhausted, CountedProblem, run_multistart
 from ..sparse.local_search import local_slsqp
 from .nelder_mead import local_nelder_mead
-from .problem import BudgetExhausted, CountedProblem, run_multistart
 
 __all__ = ["minimize_genetic", "polynomial_mutation", "sbx_crossover"]
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from mechopt.errors import MechoptError
 
-from .problem import CountedProblem
+from ..budget import CountedProblem
 
 __all__ = ["INSTALL_HINT", "MissingLibraryError", "rejected_value", "require", "worst_feasible_value"]
 

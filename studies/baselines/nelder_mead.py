@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import OptimizeResult, minimize
 
-from .problem import CountedProblem, run_multistart
+from ..budget import CountedProblem, run_multistart
 
 __all__ = ["local_nelder_mead", "minimize_nelder_mead"]
 

@@ -42,8 +42,8 @@ from typing import Any
 import numpy as np
 from scipy.optimize import OptimizeResult
 
+from ..budget import BudgetExhausted, CountedProblem
 from .library import rejected_value, require
-from .problem import BudgetExhausted, CountedProblem
 
 __all__ = ["minimize_optuna_cmaes", "minimize_optuna_tpe"]
 

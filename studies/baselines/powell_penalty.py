@@ -21,7 +21,7 @@ from collections.abc import Sequence
 import numpy as np
 from scipy.optimize import OptimizeResult, minimize
 
-from .problem import BudgetExhausted, CountedProblem, run_multistart
+from ..budget import BudgetExhausted, CountedProblem, run_multistart
 
 __all__ = ["minimize_powell_penalty"]
 

@@ -37,8 +37,8 @@ from typing import Any
 import numpy as np
 from scipy.optimize import OptimizeResult
 
+from ..budget import BudgetExhausted, CountedProblem
 from .library import require
-from .problem import BudgetExhausted, CountedProblem
 
 __all__ = ["default_pop_size", "minimize_pymoo_de", "minimize_pymoo_ga", "minimize_pymoo_pso"]
 

@@ -21,8 +21,8 @@ from scipy.optimize import OptimizeResult, minimize
 from scipy.spatial import Delaunay, QhullError
 from scipy.stats import qmc
 
+from ..budget import BudgetExhausted, CountedProblem
 from .bayesian import GaussianProcess
-from .problem import BudgetExhausted, CountedProblem
 
 __all__ = ["fit_and_search_rbf"]
 

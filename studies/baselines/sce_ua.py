@@ -18,7 +18,7 @@ import math
 import numpy as np
 from scipy.optimize import OptimizeResult
 
-from .problem import BudgetExhausted, CountedProblem
+from ..budget import BudgetExhausted, CountedProblem
 
 __all__ = ["minimize_sce_ua"]
 

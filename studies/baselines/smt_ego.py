@@ -30,8 +30,8 @@ from typing import Any
 import numpy as np
 from scipy.optimize import OptimizeResult, minimize
 
+from ..budget import BudgetExhausted, CountedProblem
 from .library import require, worst_feasible_value
-from .problem import BudgetExhausted, CountedProblem
 
 __all__ = ["minimize_smt_ego"]
 

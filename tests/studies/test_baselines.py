@@ -23,7 +23,7 @@ from mechopt.studies.baselines import IN_HOUSE_BASELINES as BASELINES
 from mechopt.studies.baselines.bayesian import GaussianProcess, expected_improvement
 from mechopt.studies.baselines.genetic import polynomial_mutation, sbx_crossover
 from mechopt.studies.baselines.powell_penalty import minimize_powell_penalty
-from mechopt.studies.baselines.problem import run_multistart
+from mechopt.studies.budget import run_multistart
 
 BOX = np.array([[-2.0, 2.0]] * 3)
 

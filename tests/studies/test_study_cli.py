@@ -130,3 +130,44 @@ def test_paper_plan_is_expressible():
     np.testing.assert_allclose(plan.direction, [0.0, 0.920, 0.503])
     np.testing.assert_allclose(plan.origin, [31.000, 257.859, 72.705])
     assert 0 < coverage <= 1
+
+
+def test_every_study_flag_end_to_end(tmp_path, capsys):
+    # --no-refine used to fail on every run (the options check rejected every boolean).
+    args = ["study", "ventilator", "--out", str(tmp_path / "o"), "--store", str(tmp_path / "s.sqlite"),
+            "--engine", "analytic", "--workers", "1", "--no-progress", "--plan", "paper", "--lines-fit", "7",
+            "--samples-per-line", "12", "--search-points", "100000", "--budget", "100", "--seed", "2",
+            "--no-refine", "--lines", "2", "--points-per-line", "5", "--retry-failed", "--truth",
+            "--truth-grid", "4"]
+    assert main(args) == 0, capsys.readouterr().err
+    result = json.loads((tmp_path / "o" / "result.json").read_text())
+    assert [s["name"] for s in result["stages"]] == ["global"]  # no refinement
+    assert result["options"]["plan"] == "paper" and result["options"]["seed"] == 2
+    assert result["validation"]["n_lines"] == 2 and result["ground_truth"]["grid_step"] == 4
+    assert result["simulations"]["optimisation"] <= 100
+    out = capsys.readouterr().out
+    assert "ground truth" in out and "reused" in out
+
+
+def test_two_studies_at_once_on_one_store_share_the_work(tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    store = tmp_path / "shared.sqlite"
+    cmd = [sys.executable, "-m", "mechopt.studies.cli", "study", "ventilator", "--store", str(store), "--lines", "0",
+           *SMALL, "--lines-fit", "7", "--samples-per-line", "14", "--budget", "120"]
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    procs = [subprocess.Popen([*cmd, "--out", str(tmp_path / f"run{i}")], env=env, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True) for i in range(2)]
+    for p in procs:
+        _, err = p.communicate(timeout=600)
+        assert p.returncode == 0, err
+    runs = [json.loads((tmp_path / f"run{i}" / "result.json").read_text())["simulations"] for i in range(2)]
+    # Alone, one run simulates all its distinct designs; together the two split them (the store's claims), up to
+    # the few designs in flight when one run waits for the other's claim.
+    distinct = runs[0]["distinct_designs"]
+    assert runs[1]["distinct_designs"] == distinct
+    assert runs[0]["new"] + runs[1]["new"] <= distinct + 4
+    assert runs[0]["waited_for_other_runs"] + runs[1]["waited_for_other_runs"] + runs[0]["reused"] + \
+        runs[1]["reused"] >= distinct - 4
