@@ -156,7 +156,7 @@ def test_two_studies_at_once_on_one_store_share_the_work(tmp_path):
 
     store = tmp_path / "shared.sqlite"
     cmd = [sys.executable, "-m", "mechopt.studies.cli", "study", "ventilator", "--store", str(store), "--lines", "0",
-           *SMALL, "--lines-fit", "7", "--samples-per-line", "14", "--budget", "120"]
+           *SMALL, "--lines-fit", "5", "--samples-per-line", "10", "--budget", "70"]
     env = {**os.environ, "MPLBACKEND": "Agg"}
     procs = [subprocess.Popen([*cmd, "--out", str(tmp_path / f"run{i}")], env=env, stdout=subprocess.PIPE,
                               stderr=subprocess.PIPE, text=True) for i in range(2)]
