@@ -206,9 +206,10 @@ def _cmd_validate(args: argparse.Namespace, rest: list[str]) -> int:
     figure = plot_validation(val.lines, out / "figures" / "validation_heldout.png", fit_lines, model,
                              label=study.problem.objective)
     (out / "validation.json").write_text(json.dumps(val.summary(), indent=2))
+    low = (f", {val.rmse_low:.4g} where {study.problem.objective} is <= 2 × the best simulated value"
+           if math.isfinite(val.rmse_low) else "")
     print(f"{val.n_points} held-out simulations on {len(val.lines)} lines: RMSE {val.rmse:.4g} "
-          f"({val.relative_text()}), {val.rmse_low:.4g} where {study.problem.objective} is <= 2 × the best simulated "
-          f"value, max error {val.max_error:.4g}")
+          f"({val.relative_text()}){low}, max error {val.max_error:.4g}")
     print(f"figure written to {figure}")
     return 0
 
