@@ -31,7 +31,7 @@ def _slice_values(problem: DesignProblem, marks: Mapping[str, np.ndarray], n_sli
             break
         if v not in keep:
             keep.append(v)
-    return sorted(keep)[:max(n_slices, len(keep))]
+    return sorted(keep)
 
 
 def plot_feasible_slices(problem: DesignProblem, path: str | Path, marks: Mapping[str, np.ndarray] | None = None,
