@@ -20,11 +20,14 @@ Subpackages: :mod:`mechopt.sim` (the physics: one folder per mechanism), :mod:`m
 independent of the physics) and :mod:`mechopt.studies` (the engine that runs a study, and the shipped studies).
 """
 
-from ._numba_cache import use_user_cache
+# pytest imports the checkout's root __init__.py as a plain file (no parent package) when the clone's folder name is
+# not a valid module name (e.g. /tmp/tmp.XYZ); then there is nothing to set up.
+if __package__:
+    from ._numba_cache import use_user_cache
 
-use_user_cache()
+    use_user_cache()
 
-from .errors import InfeasibleDesignError, InputError, MechoptError, StudyError  # noqa: E402
+    from .errors import InfeasibleDesignError, InputError, MechoptError, StudyError
 
 __version__ = "0.2.0"
 
