@@ -140,6 +140,10 @@ class DesignProblem:
     surrogate_order : tuple of int or None
         Order of the variables in the sparse model's coordinates (paper 002 plans the ventilator over
         (|OA|, |BC|, |AB|)); None keeps the declared order.
+    fd_step : float
+        Finite-difference step of local searches on the simulator, as a fraction of each variable's range: above
+        the simulator's noise (a time-stepping engine: 1e-3), as small as the arithmetic allows for a smooth,
+        closed-form one (1e-5, the default).
     """
 
     name: ClassVar[str] | str = "problem"
@@ -151,6 +155,7 @@ class DesignProblem:
     output_units: dict[str, str] = {}  # noqa: RUF012 - read-only class default
     version: int = 1
     surrogate_order: tuple[int, ...] | None = None
+    fd_step: float = 1e-5
 
     # --- to implement -------------------------------------------------------------------------------------------
 

@@ -77,6 +77,11 @@ class ExternalProblem(DesignProblem):
     def surrogate_order(self) -> tuple[int, ...] | None:  # type: ignore[override]
         return self.base.surrogate_order
 
+    @property
+    def fd_step(self) -> float:  # type: ignore[override]
+        # A user's simulator (a CAD batch run, a solver with tolerances) is assumed noisy until it says otherwise.
+        return 1e-3
+
     def evaluate(self, x: np.ndarray) -> dict[str, float]:
         """Outputs of design ``x`` (the variables' units) from the simulator.
 

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .options import SparseOptions
-from .refine import refine_locally
+from .refine import model_steps, refine_locally
 from .sampler import Sampler
 from .space import ModelSpace
 from .stage import Stage, build_stage
@@ -90,15 +90,25 @@ def run_pipeline(space: ModelSpace, options: SparseOptions, sampler: Sampler,
         start, start_value = samples[ok][np.argmin(values[ok])], float(values[ok].min())
         log(f"  the best line sample ({problem.describe(start)}, {start_value:.6g}) beats the model's candidate: "
             "the local search starts there")
-    if options.refine and remaining > space.dim + 1 and np.isfinite(start_value):
-        refined = refine_locally(space, sampler, start, remaining, stage, options.fd_step)
-        stages.append(refined)
-        log(f"  refinement: {refined.n_samples} simulations of a constrained local search (SLSQP) from the "
-            f"candidate; {problem.describe(refined.candidate)}, simulated {refined.simulated:.6g}")
-        if refined.simulated < best.simulated or not np.isfinite(best.simulated):
-            best = refined
-        message = (f"model and simulation differ by {stage.agreement:.2%} at the model's candidate; a local search on "
-                   f"the simulator moved it from {stage.simulated:.6g} to {best.simulated:.6g}")
+    if options.refine and remaining > 0 and np.isfinite(start_value):
+        # First the model steers (one simulation per step), then finite differences finish from where it stalled.
+        stepped = model_steps(space, sampler, stage, remaining, options.seed)
+        remaining -= stepped.n_samples
+        stages.append(stepped)
+        log(f"  model steps: {stepped.n_samples} simulations of trust-region steps on the corrected model; "
+            f"{problem.describe(stepped.candidate)}, simulated {stepped.simulated:.6g}")
+        if stepped.simulated < best.simulated or not np.isfinite(best.simulated):
+            best = stepped
+        if remaining > space.dim + 1:
+            fd_step = options.fd_step if options.fd_step is not None else problem.fd_step
+            refined = refine_locally(space, sampler, best.candidate, remaining, stage, fd_step)
+            stages.append(refined)
+            log(f"  refinement: {refined.n_samples} simulations of a constrained local search (SLSQP) from the "
+                f"best design; {problem.describe(refined.candidate)}, simulated {refined.simulated:.6g}")
+            if refined.simulated < best.simulated:
+                best = refined
+        message = (f"model and simulation differ by {stage.agreement:.2%} at the model's candidate; model steps and a "
+                   f"local search on the simulator moved it from {stage.simulated:.6g} to {best.simulated:.6g}")
     elif stage.agreement > options.rel_tol:
         message = f"model and simulation disagree by {stage.agreement:.2%} at the candidate; no budget left to refine"
     return PipelineResult(stages=stages, best=best, n_simulations=len(sampler.designs) - used_before, message=message)

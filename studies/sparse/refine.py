@@ -11,8 +11,9 @@ from .local_search import local_slsqp
 from .sampler import Sampler
 from .space import ModelSpace
 from .stage import Stage
+from .trust_region import trust_region_steps
 
-__all__ = ["refine_locally"]
+__all__ = ["model_steps", "refine_locally"]
 
 
 def refine_locally(space: ModelSpace, sampler: Sampler, x0: np.ndarray, budget: int, model_stage: Stage,
@@ -67,3 +68,48 @@ def refine_locally(space: ModelSpace, sampler: Sampler, x0: np.ndarray, budget: 
                  model=model_stage.model, line_designs=[], line_values=[], candidate=x,
                  predicted=float(model_stage.model.predict(x)[0]), simulated=simulated,
                  search_time_s=time.perf_counter() - t0, fit_time_s=0.0, n_samples=problem.nfev)
+
+
+def model_steps(space: ModelSpace, sampler: Sampler, model_stage: Stage, budget: int, seed: int = 0) -> Stage:
+    """Trust-region steps on the global model corrected by every simulation so far (:mod:`.trust_region`).
+
+    Parameters
+    ----------
+    space : ModelSpace
+        The problem's box and constraints.
+    sampler : Sampler
+        The simulator through the store (every step is one simulation, counted against ``budget``).
+    model_stage : Stage
+        The global model, its line samples and its simulated candidate.
+    budget : int
+        Most simulations.
+    seed : int
+        Seed of the points each step's search starts from.
+
+    Returns
+    -------
+    Stage
+        ``candidate`` the best design simulated by the steps or before them, ``n_samples`` the steps taken.
+    """
+    t0 = time.perf_counter()
+    model = model_stage.model
+    square = model.fit == "square"
+    X = np.vstack([*model_stage.line_designs, model_stage.candidate[None, :]])
+    f = np.concatenate([*model_stage.line_values, [model_stage.simulated]])
+
+    def simulate(x: np.ndarray) -> float:
+        value = float(sampler(np.asarray(x, dtype=float)[None, :], desc="model steps")[0])
+        return value * value if square else value
+
+    progress, sampler.progress = sampler.progress, False
+    try:
+        res = trust_region_steps(lambda Xc: model.model.predict(model.to_u(Xc)), simulate, space.feasible,
+                                 space.box, X, f * f if square else f, budget, seed,
+                                 space.margins if space.problem.constraints else None)
+    finally:
+        sampler.progress = progress
+    x = np.asarray(res.x, dtype=float)
+    simulated = float(np.sqrt(max(res.value, 0.0)) if square else res.value)
+    return Stage(name="model steps", plan=model_stage.plan, coverage=model_stage.coverage, model=model,
+                 line_designs=[], line_values=[], candidate=x, predicted=float(model.predict(x)[0]),
+                 simulated=simulated, search_time_s=time.perf_counter() - t0, fit_time_s=0.0, n_samples=res.n_steps)

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mechopt.errors import MechoptError
+from mechopt.surrogate.errors import SurrogateError
 from mechopt.surrogate import LinePlan, SparseExponentialModel, exhaustive_search, plan_lines
 
 from .feasible_point import pull_into_feasible
@@ -96,10 +97,20 @@ def plan_stage(space: ModelSpace, options: SparseOptions, n_lines: int, samples_
     """The lines of a model over the whole region (model coordinates) and their hull's coverage."""
     if paper:
         return paper_plan(space, options)
-    res = plan_lines(space.lower_u, space.upper_u, space.feasible_u, n_lines=n_lines,
-                     samples_per_line=samples_per_line, min_samples=min(options.min_samples, samples_per_line),
-                     seed=options.seed, sampleable=space.sampleable_u, layout=options.layout)
-    return res.plan, float(res.coverage)
+    min_samples = min(options.min_samples, samples_per_line)
+    # A small plan (3 lines of 4) asks every line to be feasible end to end; where the region's corners are thin
+    # no line through them is, so a line may grow a little longer before the plan is declared impossible.
+    for extra in (0, 1, 2, 4):
+        try:
+            res = plan_lines(space.lower_u, space.upper_u, space.feasible_u, n_lines=n_lines,
+                             samples_per_line=samples_per_line + extra, min_samples=min_samples, seed=options.seed,
+                             sampleable=space.sampleable_u, layout=options.layout)
+            return res.plan, float(res.coverage)
+        except SurrogateError as exc:
+            if "no direction gave" not in str(exc) or samples_per_line > 8:
+                raise
+            error = exc
+    raise error
 
 
 def build_stage(name: str, space: ModelSpace, options: SparseOptions, sampler: Sampler, n_lines: int,

@@ -78,17 +78,17 @@ def test_the_pipeline_finds_the_minimum_of_a_smooth_4d_function():
 
 def test_refinement_improves_on_the_model_candidate_within_the_budget(ventilator):
     problem = mechopt.load_study("ventilator", {"engine": "analytic"}).problem
-    # A coarse model (4 lines of 8 samples) misses the optimum, which lies on the region's boundary: the local
-    # search on the simulator must take over, and nothing may exceed the budget.
-    result = mechopt.minimize(problem, budget=80, seed=0, options={"n_lines": 4, "samples_per_line": 8,
-                                                                    "min_samples": 5, "max_order": 3,
-                                                                    "search_points": 200_000})
-    global_stage, refined = result.stages
-    assert refined.name == "local refinement" and refined.n_samples > 0
-    assert result.nfev <= 80
+    # The small first plan of a small budget (3 lines of 4 samples) misses the optimum, which lies on the region's
+    # boundary: the model's steps and the local search on the simulator must take over, within the budget.
+    result = mechopt.minimize(problem, budget=40, seed=0, options={"search_points": 200_000})
+    global_stage, stepped, *refined = result.stages
+    assert stepped.name == "model steps" and stepped.n_samples > 0
+    assert [s.name for s in refined] in ([], ["local refinement"])
+    assert result.nfev <= 40
+    assert sum(s.n_samples for s in result.stages) + 1 <= 40
     # The model's candidate was simulated, not taken from the model.
     assert np.isfinite(global_stage.simulated) and global_stage.simulated != global_stage.predicted
-    assert refined.simulated < global_stage.simulated
+    assert min(s.simulated for s in result.stages[1:]) < global_stage.simulated
     assert result.fun == min(s.simulated for s in result.stages)
     assert problem.feasible(result.x)[0]
     assert result.fun < T_TRUE * 1.005

@@ -1,0 +1,205 @@
+"""Refinement by the model itself: trust-region steps on the line model corrected by every simulation so far.
+
+The global model of a small budget (3-4 lines) is right about the shape of the landscape and wrong by a few per cent
+in its level and in the position of its minimum.  A local search with forward differences on the simulator ignores
+it and pays d + 1 simulations per gradient.  Here each simulation is one step: the line model plus a radial-basis
+correction that interpolates its residuals at every simulated design (line samples, candidate, earlier steps) is
+minimised inside a trust region around the best design, its minimiser simulated, and the region grown or shrunk by
+how much of the predicted decrease came true (the classical ratio test of surrogate-based trust-region methods).
+The model's gradient thus steers every step; the simulations keep it honest.  When the region has shrunk to nothing
+the corrected model has nothing left to say and the caller hands what is left of the budget to the finite-difference
+search, which then starts next to the optimum.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.interpolate import RBFInterpolator
+from scipy.optimize import minimize
+from scipy.stats import qmc
+
+__all__ = ["TrustRegionResult", "trust_region_steps"]
+
+#: First half-width of the region, as a fraction of each variable's range.
+RADIUS_START = 0.5
+#: Below this half-width (fraction of the range) a step moves less than a finite-difference search would resolve.
+RADIUS_MIN = 2e-3
+#: Accepted steps shorter than this (fraction of the range) creep along a valley the corrected model cannot see
+#: across; after two in a row the steps run down the valley along the last step, and end when that fails.
+CREEP = 0.02
+#: Ratio of actual to predicted decrease above which the region grows, below which it shrinks.
+GROW, SHRINK = 0.75, 0.25
+
+
+@dataclass
+class TrustRegionResult:
+    """Where the steps ended.
+
+    Attributes
+    ----------
+    x : (d,) ndarray
+        Best simulated design.
+    value : float
+        Its fitted quantity (the objective, or its square).
+    n_steps : int
+        Simulations taken.
+    radius : float
+        Final half-width (fraction of the range).
+    """
+
+    x: np.ndarray
+    value: float
+    n_steps: int
+    radius: float
+
+
+def trust_region_steps(model: Callable[[np.ndarray], np.ndarray], simulate: Callable[[np.ndarray], float],
+                       feasible: Callable[[np.ndarray], np.ndarray], box: np.ndarray, X: np.ndarray, q: np.ndarray,
+                       budget: int, seed: int = 0,
+                       margins: Callable[[np.ndarray], np.ndarray] | None = None) -> TrustRegionResult:
+    """Minimise a simulated quantity by steps on the corrected model, within ``budget`` simulations.
+
+    Parameters
+    ----------
+    model : callable
+        The line model of the fitted quantity at designs (n, d) -> (n,) (design units in, fitted units out).
+    simulate : callable
+        The fitted quantity of one design (d,), simulated (NaN when the simulation fails).
+    feasible : callable
+        Cheap feasibility of designs (n, d) -> (n,) bool.
+    box : (d, 2) ndarray
+        Bounds of every variable (design units).
+    X, q : (n, d) and (n,) ndarrays
+        Every design simulated so far and its fitted quantity (non-finite ones are ignored).
+    budget : int
+        Most simulations.
+    seed : int
+        Seed of the candidate points inside each region.
+    margins : callable, optional
+        Constraint margins of one design (d,) -> (m,), >= 0 when feasible, for the polish of each step.
+
+    Returns
+    -------
+    TrustRegionResult
+    """
+    box = np.asarray(box, dtype=float)
+    lower, span = box[:, 0], box[:, 1] - box[:, 0]
+    d = lower.size
+    keep = np.isfinite(q)
+    X = np.asarray(X, dtype=float)[keep]
+    U = (X - lower) / span
+    q = np.asarray(q, dtype=float)[keep]
+    # Samples outside the region (lines run past it) inform the correction; only a feasible one may be the start.
+    inside = np.asarray(feasible(X), dtype=bool)
+    if not inside.any():
+        return TrustRegionResult(x=np.full(d, np.nan), value=float("nan"), n_steps=0, radius=0.0)
+    best = int(np.flatnonzero(inside)[np.argmin(q[inside])])
+    u_best, q_best = U[best].copy(), float(q[best])
+    radius, steps, creeping = RADIUS_START, 0, 0
+    rng = np.random.default_rng(seed)
+    sobol = qmc.Sobol(d, seed=rng)
+    scale = max(float(np.ptp(q)), abs(q_best), 1e-300)
+
+    def base(Uc: np.ndarray) -> np.ndarray:
+        return np.asarray(model(lower + np.atleast_2d(Uc) * span), dtype=float)
+
+    while steps < budget and radius >= RADIUS_MIN:
+        residual = (q - base(U)) / scale
+        # Thin-plate splines with a linear tail interpolate the residuals exactly and stay mild between samples; a
+        # tiny smoothing keeps the system solvable when two designs nearly coincide.
+        correction = _residual_model(U, residual)
+
+        def corrected(Uc: np.ndarray) -> np.ndarray:
+            Uc = np.atleast_2d(Uc)
+            return base(Uc) / scale + correction(Uc)
+
+        lo, hi = np.maximum(u_best - radius, 0.0), np.minimum(u_best + radius, 1.0)
+        cloud = lo + sobol.random(512) * (hi - lo)
+        cloud = np.vstack([u_best, cloud[np.asarray(feasible(lower + cloud * span), dtype=bool)]])
+        values = corrected(cloud)
+        u_new = _polish(corrected, cloud[np.argsort(values)[:3]], lo, hi, lower, span, margins, feasible)
+        predicted = float(corrected(u_new)[0])
+        here = float(corrected(u_best)[0])
+        if np.max(np.abs(u_new - u_best) / np.maximum(radius, 1e-12)) < 1e-3 or here - predicted <= 1e-12:
+            # The corrected model sees no decrease in this region: look closer.
+            radius *= 0.5
+            continue
+        if np.min(np.max(np.abs(U - u_new), axis=1)) < 1e-7:
+            radius *= 0.5
+            continue
+        value = float(simulate(lower + u_new * span))
+        steps += 1
+        if not np.isfinite(value):
+            radius *= 0.5
+            continue
+        U, q = np.vstack([U, u_new]), np.append(q, value)
+        import os
+        if os.environ.get("TRDEBUG"): print(f"    step {steps} r={radius:.3g} pred={predicted*scale:.5g} here={here*scale:.5g} val={value:.5g} best={q_best:.5g} u={np.round(lower+u_new*span,2)}")
+        ratio = (q_best - value) / max((here - predicted) * scale, 1e-300)
+        on_edge = np.any(np.abs(u_new - u_best) > 0.9 * radius)
+        if value < q_best:
+            step = u_new - u_best
+            creeping = creeping + 1 if np.max(np.abs(step)) < CREEP else 0
+            u_best, q_best = u_new, value
+            if creeping >= 2:
+                # Creeping along a valley: the last step points down it, so run down that line with doubling steps
+                # while the simulations keep decreasing (a straight valley is crossed in a few simulations).
+                creeping = 0
+                factor, moved = 2.0, False
+                while steps < budget:
+                    u_try = u_best + factor * step
+                    if np.any(u_try < 0.0) or np.any(u_try > 1.0) or not feasible(lower + u_try[None, :] * span)[0]:
+                        break
+                    value = float(simulate(lower + u_try * span))
+                    steps += 1
+                    if not np.isfinite(value):
+                        break
+                    U, q = np.vstack([U, u_try]), np.append(q, value)
+                    if value >= q_best:
+                        break
+                    u_best, q_best, moved = u_try, value, True
+                    factor *= 2.0
+                if not moved:
+                    break
+                continue
+            if ratio > GROW and on_edge:
+                radius = min(2.0 * radius, 0.5)
+            elif ratio < SHRINK:
+                radius *= 0.5
+        else:
+            radius *= 0.5
+    return TrustRegionResult(x=lower + u_best * span, value=q_best, n_steps=steps, radius=radius)
+
+
+def _residual_model(U: np.ndarray, residual: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
+    """Thin-plate spline of the residuals with a linear tail, a constant one when the designs span too few
+    dimensions for a plane (few lines, all samples in one plane), nothing when even that fails."""
+    for degree in (1, 0):
+        try:
+            return RBFInterpolator(U, residual, kernel="thin_plate_spline", degree=degree, smoothing=1e-10)
+        except np.linalg.LinAlgError:
+            continue
+    return lambda Uc: np.zeros(len(np.atleast_2d(Uc)))
+
+
+def _polish(corrected: Callable[[np.ndarray], np.ndarray], starts: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+            lower: np.ndarray, span: np.ndarray, margins: Callable[[np.ndarray], np.ndarray] | None,
+            feasible: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+    """The best feasible local minimum of the corrected model from a few starts (all model calls, no simulation)."""
+    constraints = [] if margins is None else [{"type": "ineq", "fun": lambda u: margins(lower + u * span)}]
+    best_u, best_v = starts[0], float(corrected(starts[0])[0])
+    for u0 in starts:
+        v0 = float(corrected(u0)[0])
+        if v0 < best_v:
+            best_u, best_v = u0, v0
+        res = minimize(lambda u: float(corrected(u)[0]), u0, method="SLSQP", bounds=list(zip(lo, hi, strict=True)),
+                       constraints=constraints, options={"maxiter": 100, "ftol": 1e-12})
+        u = np.clip(res.x, lo, hi)
+        if np.all(np.isfinite(u)) and feasible(lower + u[None, :] * span)[0]:
+            v = float(corrected(u)[0])
+            if v < best_v:
+                best_u, best_v = u, v
+    return best_u
