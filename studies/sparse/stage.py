@@ -8,8 +8,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from mechopt.errors import MechoptError
-from mechopt.surrogate.errors import SurrogateError
 from mechopt.surrogate import LinePlan, SparseExponentialModel, exhaustive_search, plan_lines
+from mechopt.surrogate.errors import SurrogateError
 
 from .feasible_point import pull_into_feasible
 from .model import ObjectiveModel

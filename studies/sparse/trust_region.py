@@ -112,7 +112,7 @@ def trust_region_steps(model: Callable[[np.ndarray], np.ndarray], simulate: Call
         # tiny smoothing keeps the system solvable when two designs nearly coincide.
         correction = _residual_model(U, residual)
 
-        def corrected(Uc: np.ndarray) -> np.ndarray:
+        def corrected(Uc: np.ndarray, correction=correction) -> np.ndarray:
             Uc = np.atleast_2d(Uc)
             return base(Uc) / scale + correction(Uc)
 
@@ -136,8 +136,6 @@ def trust_region_steps(model: Callable[[np.ndarray], np.ndarray], simulate: Call
             radius *= 0.5
             continue
         U, q = np.vstack([U, u_new]), np.append(q, value)
-        import os
-        if os.environ.get("TRDEBUG"): print(f"    step {steps} r={radius:.3g} pred={predicted*scale:.5g} here={here*scale:.5g} val={value:.5g} best={q_best:.5g} u={np.round(lower+u_new*span,2)}")
         ratio = (q_best - value) / max((here - predicted) * scale, 1e-300)
         on_edge = np.any(np.abs(u_new - u_best) > 0.9 * radius)
         if value < q_best:
