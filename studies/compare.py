@@ -220,11 +220,18 @@ def plot_gaps(rows: list[dict], path: Path) -> Path:
 
 
 def simulations_needed(rows: list[dict]) -> dict[str, int | None]:
-    """Per method, the fewest budget after which the median run reaches the optimum (None: never, in the runs)."""
+    """Per method, the fewest budget from which on the median run reaches the optimum at every larger budget too
+    (None: not at the largest budget).  A method that reaches it once and loses it at a larger budget is not
+    counted as having reached it there."""
     out: dict[str, int | None] = {}
     for method in dict.fromkeys(r["method"] for r in rows):
-        reached = sorted(r["budget"] for r in rows if r["method"] == method and r["median_reached"])
-        out[method] = reached[0] if reached else None
+        by_budget = sorted((r["budget"], bool(r["median_reached"])) for r in rows if r["method"] == method)
+        needed = None
+        for budget, reached in reversed(by_budget):
+            if not reached:
+                break
+            needed = budget
+        out[method] = needed
     return out
 
 

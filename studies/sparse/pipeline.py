@@ -3,8 +3,8 @@
 1. **Global model**: lines planned over the feasible region (or the paper's Δ and origin), sampled through the
    resumable store, fitted with sums of exponentials and blended; its exhaustive search gives a candidate, which is
    simulated to confirm it.
-2. **Refinement**: a constrained local search on the simulator from the candidate, within what is left of the
-   budget (:mod:`.refine`).
+2. **Refinement**, within what is left of the budget (:mod:`.refine`): trust-region steps on the model corrected
+   by every simulation so far (:mod:`.trust_region`), then a constrained local search on the simulator.
 3. The best *simulated* design is the optimum; nothing is reported from the model alone.
 """
 
@@ -75,12 +75,12 @@ def run_pipeline(space: ModelSpace, options: SparseOptions, sampler: Sampler,
     stages, best = [stage], stage
     message = f"model and simulation agree within {stage.agreement:.2%} at the candidate"
     remaining = options.budget - (len(sampler.designs) - used_before)
-    # Agreement at one point does not prove the candidate optimal, so the local search always runs when there is
-    # budget: at a true optimum it stops after a few gradients.  One forward-difference gradient costs d simulations
-    # beyond the start; below that a local search cannot move.
+    # Agreement at one point does not prove the candidate optimal, so the refinement always runs when there is
+    # budget: first trust-region steps on the model corrected by every simulation (one simulation per step, from the
+    # best simulated design), then, from where they stall, SLSQP with forward differences (d simulations a gradient).
     # When the model's claim at its own candidate is off by more than MISTRUST, the blend did not resolve the
-    # landscape (it overshoots between lines and puts its minimum in a false basin): the best simulated design wins,
-    # and the local search starts from the best feasible line sample if it is better than the candidate.
+    # landscape (it overshoots between lines and puts its minimum in a false basin): the best line sample, not the
+    # candidate, is where the steps start.
     start, start_value = stage.candidate, stage.simulated
     samples = np.vstack(stage.line_designs)
     values = np.concatenate(stage.line_values)

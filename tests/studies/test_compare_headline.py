@@ -1,0 +1,14 @@
+"""The headline's count: the budget from which on a method's median run stays at the optimum."""
+
+from mechopt.studies.compare import headline, simulations_needed
+
+
+def test_simulations_needed_counts_from_where_the_median_stays_reached():
+    rows = [{"method": m, "budget": b, "median_reached": r} for m, b, r in [
+        ("steady", 10, False), ("steady", 20, True), ("steady", 40, True),
+        ("lucky", 10, True), ("lucky", 20, False), ("lucky", 40, True),
+        ("lost", 10, True), ("lost", 20, True), ("lost", 40, False),
+        ("never", 10, False), ("never", 20, False), ("never", 40, False)]]
+    assert simulations_needed(rows) == {"steady": 20, "lucky": 40, "lost": None, "never": None}
+    text = headline({"study": simulations_needed(rows)}, {"study": 40})
+    assert "| steady | 20 |" in text and "| lost | > 40 |" in text
