@@ -25,7 +25,7 @@ def main() -> None:
     for path in args.runs:
         data = json.loads(path.read_text())
         needed[data["study"]] = data["needed"]
-        budgets[data["study"]] = max(r["budget"] for r in data["rows"])
+        budgets[data["study"]] = {m: max(r["budget"] for r in data["rows"] if r["method"] == m) for m in data["needed"]}
     args.out.mkdir(parents=True, exist_ok=True)
     text = headline(needed, budgets)
     (args.out / "headline.md").write_text(text)

@@ -319,12 +319,13 @@ def _cmd_compare(args: argparse.Namespace, rest: list[str]) -> int:
             truth = load_or_compute(study.problem, out / f"ground_truth_{args.truth_grid:g}.json", args.truth_grid)
         print(f"{study.name}: optimum {study.problem.objective} {truth.fun:.6g} at "
               f"{study.problem.describe(np.array(truth.x))}")
-        runs = cmp.compare(study, truth, args.budgets, args.seeds, methods)
+        runs = cmp.compare(study, truth, args.budgets, args.seeds, methods, gp_max_budget=args.gp_max_budget)
         md, fig = cmp.write(runs, truth, out, study, args.seeds)
         print(md.read_text())
         print(f"table written to {md}, figure to {fig}")
-        needed[study.name] = cmp.simulations_needed(cmp.table(runs, study.problem, truth))
-        budgets[study.name] = max(args.budgets)
+        rows = cmp.table(runs, study.problem, truth)
+        needed[study.name] = cmp.simulations_needed(rows)
+        budgets[study.name] = cmp.largest_budgets(rows)
     if len(studies) > 1:
         text = cmp.headline(needed, budgets)
         (base / "headline.md").write_text(text)
@@ -404,6 +405,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--methods", help="comma-separated subset of the methods (default: all)")
     p.add_argument("--out", metavar="DIR", help="output folder (default: STUDY-study)")
     p.add_argument("--truth-grid", type=_positive_float, default=1.0, help="grid of the ground truth brute force")
+    p.add_argument("--gp-max-budget", type=_positive_int, metavar="N",
+                   help="largest budget of the Gaussian-process methods (bayesian, smt_ego; default 200 and 100): "
+                   "they refit at every call and take minutes a run")
     p.set_defaults(func=_cmd_compare)
 
     p = sub.add_parser("init", help="copy a packaged study (its TOML and data) to start a study of your own")

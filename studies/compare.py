@@ -13,6 +13,7 @@ import json
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -102,8 +103,15 @@ def gap_pct(problem: DesignProblem, truth: GroundTruth, value: float) -> float:
 
 
 def compare(study: Study, truth: GroundTruth, budgets: list[int], seeds: int, methods: list[str] | None = None,
-            progress=print) -> list[Run]:
-    """Run every method at every budget and seed; returns the runs (see :func:`table`)."""
+            progress=print, gp_max_budget: int | None = None) -> list[Run]:
+    """Run every method at every budget and seed; returns the runs (see :func:`table`).
+
+    ``gp_max_budget`` lowers the largest budget the Gaussian-process methods (``bayesian``, ``smt_ego``) run at:
+    they refit at every call, and a run of a hundred calls takes minutes where the others take seconds.
+    """
+    caps = {"bayesian": BAYESIAN_MAX_BUDGET, "smt_ego": EGO_MAX_BUDGET}
+    if gp_max_budget is not None:
+        caps = {k: min(v, int(gp_max_budget)) for k, v in caps.items()}
     names = ["mechopt", "mechopt-global", *BASELINES]
     if methods:
         unknown = sorted(set(methods) - set(names))
@@ -115,7 +123,7 @@ def compare(study: Study, truth: GroundTruth, budgets: list[int], seeds: int, me
     for budget in budgets:
         for seed in range(seeds):
             for name in names:
-                if budget > {"bayesian": BAYESIAN_MAX_BUDGET, "smt_ego": EGO_MAX_BUDGET}.get(name, budget):
+                if budget > caps.get(name, budget):
                     continue
                 t0 = time.perf_counter()
                 try:
@@ -235,8 +243,24 @@ def simulations_needed(rows: list[dict]) -> dict[str, int | None]:
     return out
 
 
-def headline(needed: dict[str, dict[str, int | None]], budgets: dict[str, int]) -> str:
-    """Markdown table: studies (columns) × methods (rows), the simulations each needs to reach the optimum."""
+def largest_budgets(rows: list[dict]) -> dict[str, int]:
+    """Per method, the largest budget it ran at (the Gaussian-process methods stop below the others)."""
+    out: dict[str, int] = {}
+    for r in rows:
+        out[r["method"]] = max(out.get(r["method"], 0), int(r["budget"]))
+    return out
+
+
+def _largest(budgets: dict[str, Any], study: str, method: str) -> int:
+    b = budgets[study]
+    return int(b.get(method, max(b.values()))) if isinstance(b, dict) else int(b)
+
+
+def headline(needed: dict[str, dict[str, int | None]], budgets: dict[str, Any]) -> str:
+    """Markdown table: studies (columns) × methods (rows), the simulations each needs to reach the optimum.
+
+    ``budgets`` gives each study's largest budget, or a mapping of each method's (see :func:`largest_budgets`).
+    """
     studies = list(needed)
     methods = list(dict.fromkeys(m for n in needed.values() for m in n))
     lines = ["| method | " + " | ".join(studies) + " |", "|---|" + "---|" * len(studies)]
@@ -244,12 +268,12 @@ def headline(needed: dict[str, dict[str, int | None]], budgets: dict[str, int]) 
         cells = []
         for st in studies:
             v = needed[st].get(m, "—")
-            cells.append("—" if v == "—" else (f"> {budgets[st]}" if v is None else str(v)))
+            cells.append("—" if v == "—" else (f"> {_largest(budgets, st, m)}" if v is None else str(v)))
         lines.append(f"| {m} | " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 
 
-def plot_headline(needed: dict[str, dict[str, int | None]], budgets: dict[str, int], path: Path) -> Path:
+def plot_headline(needed: dict[str, dict[str, int | None]], budgets: dict[str, Any], path: Path) -> Path:
     """Simulations needed per method and study (log scale); a hollow bar: not reached within the largest budget."""
     from mechopt.sim.figure_file import save_figure
 
@@ -266,7 +290,7 @@ def plot_headline(needed: dict[str, dict[str, int | None]], budgets: dict[str, i
             if v == "—":
                 continue
             xs.append(i + (j - (len(studies) - 1) / 2) * width)
-            hs.append(budgets[st] * 1.5 if v is None else v)
+            hs.append(_largest(budgets, st, m) * 1.5 if v is None else v)
             hollow.append(v is None)
         bars = ax.bar(xs, hs, width=width, label=st, color=f"C{j}")
         for bar, h in zip(bars, hollow, strict=True):
@@ -292,14 +316,15 @@ def write(runs: list[Run], truth: GroundTruth, out: Path, study: Study, seeds: i
     out.mkdir(parents=True, exist_ok=True)
     (out / "compare.json").write_text(json.dumps({"study": study.name, "seeds": seeds, "truth": truth.__dict__,
                                                   "tolerance": tolerance(study.problem, truth),
-                                                  "needed": simulations_needed(rows), "rows": rows,
+                                                  "needed": simulations_needed(rows),
+                                                  "largest_budget": largest_budgets(rows), "rows": rows,
                                                   "runs": [r.__dict__ for r in runs]}, indent=2))
     md = out / "compare.md"
     needed = simulations_needed(rows)
     md.write_text(markdown(rows, truth, study, seeds)
                   + "\nSimulations after which the median run is within "
                   + f"{tolerance(study.problem, truth):.3g} of the optimum: "
-                  + ", ".join(f"{m} {'> ' + str(max(r['budget'] for r in rows)) if v is None else v}"
+                  + ", ".join(f"{m} {'> ' + str(largest_budgets(rows)[m]) if v is None else v}"
                               for m, v in needed.items()) + "\n"
                   + "\nMedian gap to the true optimum:\n\n" + pivot_markdown(rows))
     fig = plot_gaps(rows, out / "figures" / "compare_gaps.png")
