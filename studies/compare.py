@@ -279,38 +279,45 @@ def headline(needed: dict[str, dict[str, int | None]], budgets: dict[str, Any]) 
 
 
 def plot_headline(needed: dict[str, dict[str, int | None]], budgets: dict[str, Any], path: Path) -> Path:
-    """Simulations needed per method and study (log scale); a hollow bar: not reached within the largest budget."""
+    """Simulations needed per method (rows) and study (columns) as a table of colours (log scale, darker: fewer);
+    "> N" in grey: not reached within the largest budget N; blank: not run on that study."""
+    from matplotlib.colors import LogNorm
+
     from mechopt.sim.figure_file import save_figure
 
     from .plots import plt
 
     studies = list(needed)
     methods = list(dict.fromkeys(m for n in needed.values() for m in n))
-    fig, ax = plt.subplots(figsize=(max(8.0, 1.2 * len(methods) * len(studies) / 3 + 4), 5.2))
-    width = 0.8 / max(len(studies), 1)
-    for j, st in enumerate(studies):
-        xs, hs, hollow = [], [], []
-        for i, m in enumerate(methods):
+    grid = np.full((len(methods), len(studies)), np.nan)
+    for i, m in enumerate(methods):
+        for j, st in enumerate(studies):
+            v = needed[st].get(m, "—")
+            if v not in ("—", None):
+                grid[i, j] = float(v)
+    reached = grid[np.isfinite(grid)]
+    norm = LogNorm(vmin=max(1.0, reached.min() if reached.size else 1.0),
+                   vmax=max(2.0, reached.max() if reached.size else 2.0))
+    fig, ax = plt.subplots(figsize=(1.25 * len(studies) + 3.2, 0.42 * len(methods) + 1.8))
+    ax.imshow(np.ma.masked_invalid(grid), cmap="viridis_r", norm=norm, aspect="auto")
+    for i, m in enumerate(methods):
+        for j, st in enumerate(studies):
             v = needed[st].get(m, "—")
             if v == "—":
                 continue
-            xs.append(i + (j - (len(studies) - 1) / 2) * width)
-            hs.append(_largest(budgets, st, m) * 1.5 if v is None else v)
-            hollow.append(v is None)
-        bars = ax.bar(xs, hs, width=width, label=st, color=f"C{j}")
-        for bar, h in zip(bars, hollow, strict=True):
-            if h:
-                bar.set_facecolor("none")
-                bar.set_edgecolor(f"C{j}")
-                bar.set_hatch("//")
-    ax.set_yscale("log")
-    ax.set_xticks(range(len(methods)))
-    ax.set_xticklabels(methods, rotation=35, ha="right", fontsize=8)
-    ax.set_ylabel("simulations to reach the optimum (median of the seeds)")
-    ax.set_title("Simulations each method needs to reach the optimum (hatched: not within the largest budget)",
-                 fontsize=10)
-    ax.grid(alpha=0.3, axis="y", which="both")
-    ax.legend(fontsize=8)
+            if v is None:
+                ax.add_patch(plt.Rectangle((j - 0.5, i - 0.5), 1, 1, color="0.88"))
+                ax.text(j, i, f"> {_largest(budgets, st, m)}", ha="center", va="center", fontsize=7, color="0.35")
+            else:
+                dark = norm(float(v)) > 0.45
+                ax.text(j, i, str(v), ha="center", va="center", fontsize=8, fontweight="bold",
+                        color="white" if dark else "black")
+    ax.set_xticks(range(len(studies)))
+    ax.set_xticklabels(studies, rotation=30, ha="right", fontsize=8)
+    ax.set_yticks(range(len(methods)))
+    ax.set_yticklabels(methods, fontsize=8)
+    ax.set_title("Simulations each method needs to reach the optimum (median of the seeds; fewer is better)",
+                 fontsize=9)
     fig.tight_layout()
     return save_figure(fig, path)
 
