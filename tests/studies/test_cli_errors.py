@@ -132,13 +132,19 @@ def test_read_only_folders_get_one_line_and_a_healthy_read_only_store_is_not_cal
         assert "not a usable" not in err and "read-only" in err
 
 
+def _sigint_default() -> None:
+    # A test run started in the background (nohup, `cmd &`) inherits SIGINT ignored, and Python then installs no
+    # KeyboardInterrupt handler: give the child the terminal's default, as a user's shell would.
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def test_ctrl_c_leaves_one_line_and_an_intact_store(tmp_path):
     store = tmp_path / "s.sqlite"
     proc = subprocess.Popen([sys.executable, "-m", "mechopt.studies.cli", "study", "--out", str(tmp_path / "o"),
                              "--store", str(store), "--engine", "pymunk", "--workers", "2", "--no-progress",
                              "--lines-fit", "21", "--samples-per-line", "25"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            env={**os.environ, "MPLBACKEND": "Agg"})
+                            env={**os.environ, "MPLBACKEND": "Agg"}, preexec_fn=_sigint_default)
     # Interrupt once some designs are stored.
     deadline = time.time() + 240
     while time.time() < deadline:

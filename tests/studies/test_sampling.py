@@ -325,6 +325,8 @@ def _interrupt_mid_run(tmp_path: Path, sig: int, n: int, workers: int, delay: fl
         [sys.executable, str(script), str(db), str(counter), str(n), str(workers), str(delay)],
         start_new_session=True,  # its own process group: the test can find (and clean up) its workers
         stderr=subprocess.PIPE,
+        # Started from a background job, the child would inherit SIGINT ignored (no KeyboardInterrupt at all).
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     fp = ToyProblem().fingerprint()
     try:
