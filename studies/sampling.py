@@ -296,6 +296,10 @@ def sample_designs(
     stored result is kept), never lose one.
     """
     start = time.perf_counter()
+    if retry_failed:
+        # Timestamps have millisecond resolution: a failure stored in the same millisecond as this call's start
+        # would count as stored since (final), not before (to redo).  One tick later, everything before is earlier.
+        time.sleep(0.0011)
     started_at = utc_timestamp()
     if isinstance(lease_s, bool) or not isinstance(lease_s, int | float) or not lease_s > 0:
         raise InputError(f"lease_s must be a positive number of seconds, got {lease_s!r}")
