@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from recorder import Recorder
 from scipy.optimize import check_grad
 from scipy.spatial import Delaunay
 
@@ -63,32 +64,8 @@ def rastrigin_margins(x: np.ndarray) -> np.ndarray:
     return np.stack([3.0 - x[..., 0] - x[..., 2] + x[..., 1], np.linalg.norm(x - R_HOLE, axis=-1) - 1.0], axis=-1)
 
 
-class Recorder:
-    """Objective with its own call counter and feasibility log (independent of CountedProblem)."""
-
-    def __init__(self, f, margins) -> None:
-        self.f, self.margins = f, margins
-        self.xs: list[np.ndarray] = []
-        self.values: list[float] = []
-        self.feasible: list[bool] = []
-
-    def is_feasible(self, x: np.ndarray) -> bool:
-        x = np.asarray(x, dtype=float)
-        return bool(np.all(x >= BOX[:, 0]) and np.all(x <= BOX[:, 1]) and np.all(self.margins(x) >= 0.0))
-
-    def __call__(self, x: np.ndarray) -> float:
-        self.xs.append(np.array(x, dtype=float))
-        self.feasible.append(self.is_feasible(x))
-        self.values.append(self.f(x))
-        return self.values[-1]
-
-    @property
-    def calls(self) -> int:
-        return len(self.xs)
-
-
 def make(f, margins, budget: int, vectorized: bool = True, **kw) -> tuple[CountedProblem, Recorder]:
-    rec = Recorder(f, margins)
+    rec = Recorder(f, margins, BOX)
     return CountedProblem(rec, BOX, budget, margins, vectorized_constraints=vectorized, **kw), rec
 
 

@@ -19,6 +19,7 @@ import sys
 
 import numpy as np
 import pytest
+from recorder import Recorder
 
 from mechopt.studies.baselines import (
     BASELINE_DOCS,
@@ -57,32 +58,8 @@ def hole_margin(x: np.ndarray) -> np.ndarray:
     return (np.linalg.norm(x - Q_HOLE, axis=-1) - Q_R)[..., None]
 
 
-class Recorder:
-    """Objective with its own call counter and feasibility log (independent of CountedProblem)."""
-
-    def __init__(self, f, margins) -> None:
-        self.f, self.margins = f, margins
-        self.xs: list[np.ndarray] = []
-        self.values: list[float] = []
-        self.feasible: list[bool] = []
-
-    def is_feasible(self, x: np.ndarray) -> bool:
-        x = np.asarray(x, dtype=float)
-        return bool(np.all(x >= BOX[:, 0]) and np.all(x <= BOX[:, 1]) and np.all(self.margins(x) >= 0.0))
-
-    def __call__(self, x: np.ndarray) -> float:
-        self.xs.append(np.array(x, dtype=float))
-        self.feasible.append(self.is_feasible(x))
-        self.values.append(self.f(x))
-        return self.values[-1]
-
-    @property
-    def calls(self) -> int:
-        return len(self.xs)
-
-
 def make(budget: int, margins=quad_margins, f=quad, **kw) -> tuple[CountedProblem, Recorder]:
-    rec = Recorder(f, margins)
+    rec = Recorder(f, margins, BOX)
     return CountedProblem(rec, BOX, budget, margins, vectorized_constraints=True, **kw), rec
 
 
