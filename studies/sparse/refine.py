@@ -8,12 +8,13 @@ import numpy as np
 
 from ..budget import BudgetExhausted, CountedProblem
 from .local_search import local_slsqp
+from .model_exploration import explore
 from .sampler import Sampler
 from .space import ModelSpace
 from .stage import Stage
 from .trust_region import trust_region_steps
 
-__all__ = ["model_steps", "refine_locally"]
+__all__ = ["corrected_steps", "model_steps", "refine_locally"]
 
 
 def refine_locally(space: ModelSpace, sampler: Sampler, x0: np.ndarray, budget: int, model_stage: Stage,
@@ -55,6 +56,7 @@ def refine_locally(space: ModelSpace, sampler: Sampler, x0: np.ndarray, budget: 
 
     progress, sampler.progress = sampler.progress, False
     t0 = time.perf_counter()
+    n_before = len(sampler.designs)
     problem = CountedProblem(objective, space.box, budget, space.margins if space.problem.constraints else None)
     try:
         local_slsqp(problem, x0, fd_step=fd_step)
@@ -67,7 +69,9 @@ def refine_locally(space: ModelSpace, sampler: Sampler, x0: np.ndarray, budget: 
     return Stage(name="local refinement", plan=model_stage.plan, coverage=model_stage.coverage,
                  model=model_stage.model, line_designs=[], line_values=[], candidate=x,
                  predicted=float(model_stage.model.predict(x)[0]), simulated=simulated,
-                 search_time_s=time.perf_counter() - t0, fit_time_s=0.0, n_samples=problem.nfev)
+                 search_time_s=time.perf_counter() - t0, fit_time_s=0.0,
+                 # Distinct new designs: the search may ask again for one simulated before it (its start).
+                 n_samples=len(sampler.designs) - n_before)
 
 
 def model_steps(space: ModelSpace, sampler: Sampler, model_stage: Stage, budget: int, seed: int = 0) -> Stage:
@@ -113,3 +117,73 @@ def model_steps(space: ModelSpace, sampler: Sampler, model_stage: Stage, budget:
     return Stage(name="model steps", plan=model_stage.plan, coverage=model_stage.coverage, model=model,
                  line_designs=[], line_values=[], candidate=x, predicted=float(model.predict(x)[0]),
                  simulated=simulated, search_time_s=time.perf_counter() - t0, fit_time_s=0.0, n_samples=res.n_steps)
+
+
+def corrected_steps(space: ModelSpace, sampler: Sampler, model_stage: Stage, budget: int, seed: int = 0,
+                    patience: int | None = None) -> Stage:
+    """Steps at the minimum of the global model corrected by every simulation of this run, after the local search.
+
+    A finite-difference search stops where the simulator's noise hides the gradient; the corrected model
+    (:func:`.model_exploration.corrected_model`: the blend plus a cubic radial-basis interpolant of its residuals at
+    every design simulated so far) still sees the bottom of the basin from all those designs at once.  Each step
+    simulates its minimum (distance 0 from the simulated designs, polished on the model under the margins).
+
+    Parameters
+    ----------
+    space : ModelSpace
+        The problem's box and constraints.
+    sampler : Sampler
+        The simulator through the store; its ``history`` is what the correction interpolates.
+    model_stage : Stage
+        The global model.
+    budget : int
+        Most simulations.
+    seed : int
+        Seed of the candidate clouds.
+    patience : int, optional
+        Stop after this many steps in a row without a better design (default d + 1, one gradient's worth).
+
+    Returns
+    -------
+    Stage
+        ``candidate`` the best design the run has simulated, ``n_samples`` the steps taken.
+    """
+    t0 = time.perf_counter()
+    model = model_stage.model
+    square = model.fit == "square"
+    lower, span = space.box[:, 0], space.box[:, 1] - space.box[:, 0]
+    designs = [d for d, _ in sampler.history.values()]
+    values = np.array([v for _, v in sampler.history.values()], dtype=float)
+    Z = (np.array(designs, dtype=float).reshape(-1, space.dim) - lower) / span
+    inside = np.isfinite(values) & space.feasible(np.array(designs, dtype=float).reshape(-1, space.dim))
+    n_before = len(sampler.history)
+
+    def simulate(z: np.ndarray) -> float:
+        value = float(sampler((lower + z * span)[None, :], desc="corrected steps")[0])
+        return value * value if square else value
+
+    def trend(U: np.ndarray) -> np.ndarray:
+        return model.model.predict(model.to_u(lower + np.atleast_2d(U) * span))
+
+    def feasible(U: np.ndarray) -> np.ndarray:
+        return np.asarray(space.feasible(lower + np.atleast_2d(U) * span), dtype=bool)
+
+    def margins(U: np.ndarray) -> np.ndarray:
+        return np.atleast_2d([space.margins(lower + u * span) for u in np.atleast_2d(U)])
+
+    progress, sampler.progress = sampler.progress, False
+    try:
+        Z, q = explore(simulate, Z, values * values if square else values, trend, feasible, budget, seed, (0.0,),
+                       margins if space.problem.constraints else None,
+                       patience=space.dim + 1 if patience is None else patience)
+    finally:
+        sampler.progress = progress
+    ok = np.isfinite(q) & feasible(Z)
+    ok[: inside.size] &= inside
+    j = int(np.flatnonzero(ok)[np.argmin(q[ok])])
+    x = lower + Z[j] * span
+    simulated = float(np.sqrt(max(q[j], 0.0)) if square else q[j])
+    return Stage(name="corrected steps", plan=model_stage.plan, coverage=model_stage.coverage, model=model,
+                 line_designs=[], line_values=[], candidate=x, predicted=float(model.predict(x)[0]),
+                 simulated=simulated, search_time_s=time.perf_counter() - t0, fit_time_s=0.0,
+                 n_samples=len(sampler.history) - n_before)

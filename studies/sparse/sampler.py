@@ -47,6 +47,8 @@ class Sampler:
         self.n_cached = 0
         self.n_waited = 0
         self.failures: dict[str, tuple[tuple[float, ...], str]] = {}
+        #: Every design of this run and its objective (NaN when failed), by key: what later steps model.
+        self.history: dict[str, tuple[tuple[float, ...], float]] = {}
         self.sampling_time_s = 0.0
 
     @property
@@ -78,7 +80,11 @@ class Sampler:
         """The objective at designs (n, d); NaN where the simulation did not succeed."""
         records = self.records(designs, desc)
         name = self.problem.objective
-        return np.array([r.value(name) for r in records], dtype=float)
+        values = np.array([r.value(name) for r in records], dtype=float)
+        for d, v in zip(np.atleast_2d(np.asarray(designs, dtype=float)), values, strict=True):
+            design = tuple(map(float, d))
+            self.history[design_key(design)] = (design, float(v))
+        return values
 
     def summary(self) -> dict:
         """Counts for result.json and the final log line."""
