@@ -20,6 +20,7 @@ from .sparse.options import SparseOptions
 from .sparse.pipeline import run_pipeline
 from .sparse.sampler import Sampler
 from .sparse.space import ModelSpace
+from .sparse.trust import study_trust
 from .sparse.validate import validate
 from .store import SampleStore
 
@@ -27,7 +28,8 @@ __all__ = ["METHODS", "minimize"]
 
 #: ``"sparse"``: the pipeline of paper 002 (global model, confirmation, local refinement) — for smooth landscapes;
 #: ``"sparse-global"``: the same lines and blend made global on multimodal ones (basins of the blend and of its
-#: leave-one-line-out uncertainty simulated, zooms, local searches; :mod:`mechopt.studies.sparse_global`).  Every
+#: leave-one-line-out uncertainty simulated, then steps on the blend corrected by every simulation;
+#: :mod:`mechopt.studies.sparse_global`).  Every
 #: name of :data:`mechopt.studies.baselines.BASELINES` is a method too.
 METHODS = ("sparse", "sparse-global")
 
@@ -68,7 +70,9 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
     budget : int
         Most simulations the method may ask for (validation simulations of the sparse method come on top).
     method : str or callable
-        ``"sparse"`` (the line-sampled sparse model of paper 002, then a local search on the simulator), a
+        ``"sparse"`` (the line-sampled sparse model of paper 002, then a local search on the simulator),
+        ``"sparse-global"`` (for multimodal objectives: the lines' blend, its basins, then steps on the blend
+        corrected by every simulation; :mod:`mechopt.studies.sparse_global`), a
         baseline's name (``"slsqp"``, ``"differential_evolution"``...) or a callable
         ``f(counted_problem, seed) -> scipy OptimizeResult``.
     seed : int
@@ -149,7 +153,8 @@ def _sparse(problem: DesignProblem, opts: SparseOptions, sampler: Sampler, log: 
     success = bool(np.isfinite(pipeline.fun) and space.feasible(pipeline.x)[0])
     return OptimizeResult(x=pipeline.x, fun=pipeline.fun, nfev=nfev, success=success, message=pipeline.message,
                           method="sparse", model=pipeline.stages[0].model, stages=pipeline.stages,
-                          pipeline=pipeline, validation=validation, options=opts)
+                          pipeline=pipeline, validation=validation, options=opts,
+                          trust=study_trust(pipeline.stages[0], pipeline.best, validation))
 
 
 def _sparse_global(problem: DesignProblem, budget: int, seed: int, sampler: Sampler) -> OptimizeResult:

@@ -78,6 +78,7 @@ def result_dict(run) -> dict[str, Any]:
         "failures": [{"design": problem.design_dict(d), "error": e} for d, e in run.failures],
         "stages": [s.summary() for s in res.stages],
         "message": res.message,
+        "trust": res.get("trust"),
         "validation": None if val is None else {
             "rmse": val.rmse, "rmse_low": val.rmse_low, "max_error": val.max_error, "f_min": val.f_min,
             "rmse_pct_of_f_min": val.rmse_pct, "rmse_pct_of_range": val.rmse_pct_of_range, "range": val.spread,
@@ -156,6 +157,8 @@ def report_markdown(r: dict[str, Any], study) -> str:
                   f"A brute force of the batch evaluator over the whole region (grid {g['grid_step']:g}, then a "
                   f"constrained polish) finds {problem.describe(np.array([g['design'][n] for n in names]))} with "
                   f"{obj} {g['objective']:.6g}; the optimum found here is {g['gap_pct']:+.3f} % from it."]
+    if r.get("trust"):
+        lines += ["", f"**Trust**: {r['trust']['verdict']}."]
     v = r["validation"]
     if v:
         lines += ["", "## Validation", "",

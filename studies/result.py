@@ -34,6 +34,9 @@ class OptimizeResult(_ScipyResult):
         The pipeline's stages (sparse method).
     validation : Validation or None
         Held-out lines against the model (sparse method, when asked for).
+    trust : dict
+        Whether the line model resolves the landscape, and where the answer came from (``verdict``: one
+        sentence; studies and ``"sparse-global"``; :func:`mechopt.studies.sparse.trust.study_trust`).
     sampling : dict
         Counts and the executor used.
     wall_time_s : float

@@ -27,6 +27,7 @@ from .sparse.options import SparseOptions
 from .sparse.pipeline import run_pipeline
 from .sparse.sampler import Sampler
 from .sparse.space import ModelSpace
+from .sparse.trust import study_trust
 from .sparse.validate import Validation, validate
 from .store import SampleStore
 
@@ -154,10 +155,12 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
         t0 = time.perf_counter()
         ground = load_or_compute(problem, truth_file, truth_step, compute=truth)
         timings["ground_truth_s"] = time.perf_counter() - t0
+    trust = study_trust(pipeline.stages[0], pipeline.best, validation)
+    log(f"  trust: {trust['verdict']}")
     result = OptimizeResult(x=pipeline.x, fun=pipeline.fun, nfev=n_opt, success=bool(np.isfinite(pipeline.fun)),
                             message=pipeline.message, method="sparse", model=pipeline.stages[0].model,
                             stages=pipeline.stages, validation=validation,
-                            outputs=references["optimum"]["outputs"])
+                            outputs=references["optimum"]["outputs"], trust=trust)
     timings["total_s"] = time.perf_counter() - t_all
     run = StudyRun(study, options, result, validation, references, ground, timings, out, store_path, sampling,
                    failures)

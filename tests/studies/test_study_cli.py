@@ -42,6 +42,12 @@ def test_study_writes_result_report_and_figures(study_dir):
     assert sims["new"] + sims["reused"] == sims["distinct_designs"] and sims["executor"]
     report = (study_dir / "report.md").read_text()
     assert "| original |" in report and "paper_global_optimum" in report and "reused from the store" in report
+    # The trust report: its measures and its verdict, in result.json and in the report.
+    trust = result["trust"]
+    assert trust["verdict"] and trust["verdict"] in report
+    assert trust["source"] in {s["name"] for s in result["stages"]}
+    assert 0 <= trust["claim_error"] < 1 and trust["resolved"] == (max(
+        v for v in (trust["lolo_median"], trust["claim_error"], trust["heldout_error"]) if v == v) <= 0.05)
     for rel in result["figures"].values():
         path = study_dir / rel
         assert path.is_file() and path.stat().st_size > 10_000, rel
