@@ -36,6 +36,9 @@ def main() -> None:
     order = list(dict.fromkeys(r["method"] for r in base["runs"]))
     runs.sort(key=lambda r: (order.index(r.method) if r.method in order else -1, r.budget, r.seed))
     study = load_study(base["study"], {})
+    engine = study.section("compare").get("engine")
+    if engine:  # the engine the comparison ran on, as `mechopt compare` chooses it
+        study = load_study(base["study"], {"engine": engine})
     md, fig = cmp.write(runs, GroundTruth(**base["truth"]), args.out, study, base["seeds"])
     print(md.read_text())
     print(f"merged {sorted(replaced)} from {args.newer} into {args.base}: {md}, {fig}")
