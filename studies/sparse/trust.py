@@ -47,7 +47,8 @@ def study_trust(global_stage: Stage, final: Stage, validation: Validation | None
     -------
     dict
         ``lolo_median``, ``lolo_max`` (fractions of the sampled range), ``claim_error`` (fraction of the simulated
-        value), ``heldout_error`` (fraction of the held-out range, NaN without validation), ``resolved`` (bool),
+        value), ``heldout_error`` (fraction of the held-out range; each None when it could not be measured, e.g.
+        without validation), ``resolved`` (bool),
         ``source`` (the answering stage) and ``verdict`` (one sentence).
     """
     model = global_stage.model
@@ -76,8 +77,13 @@ def study_trust(global_stage: Stage, final: Stage, validation: Validation | None
         verdict = (f"the global model does not resolve the landscape at this line spacing ({', '.join(parts)}): it "
                    f"only pointed at a basin, and another basin may be lower; {where}. More lines, or "
                    "method='sparse-global', are the remedy")
-    return {"lolo_median": lolo_median, "lolo_max": lolo_max, "claim_error": claim, "heldout_error": heldout,
-            "resolved": resolved, "source": final.name, "verdict": verdict}
+    # None, not NaN, for a measure that could not be taken: result.json stays valid JSON.
+    return {"lolo_median": _or_none(lolo_median), "lolo_max": _or_none(lolo_max), "claim_error": _or_none(claim),
+            "heldout_error": _or_none(heldout), "resolved": resolved, "source": final.name, "verdict": verdict}
+
+
+def _or_none(value: float) -> float | None:
+    return float(value) if math.isfinite(value) else None
 
 
 def _pct(value: float) -> str:
