@@ -27,7 +27,10 @@ def main() -> None:
     parser.add_argument("newer", type=Path, help="compare.json whose methods replace the base's")
     parser.add_argument("--out", type=Path, required=True, help="folder of the merged comparison")
     args = parser.parse_args()
-    base, newer = json.loads(args.base.read_text()), json.loads(args.newer.read_text())
+    try:
+        base, newer = json.loads(args.base.read_text()), json.loads(args.newer.read_text())
+    except (OSError, ValueError) as exc:
+        raise SystemExit(f"error: cannot read a compare.json: {exc}") from None
     if base["study"] != newer["study"] or base["seeds"] != newer["seeds"]:
         raise SystemExit(f"error: {args.base} is {base['study']} with {base['seeds']} seeds, {args.newer} is "
                          f"{newer['study']} with {newer['seeds']}; expected the same study and seeds")

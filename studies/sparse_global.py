@@ -44,6 +44,7 @@ from mechopt.surrogate.errors import SurrogateWarning
 from mechopt.surrogate.line_error import LineOutError, blend_spread, leave_one_line_out
 
 from .sparse.model_exploration import DISTANCE_CYCLE, explore
+from .sparse.trust import RESOLVED
 
 __all__ = ["GlobalSearchResult", "global_search"]
 
@@ -495,8 +496,6 @@ def global_search(
     )
 
 
-#: Leave-one-line-out error (fraction of the sampled range) below which the blend is said to resolve the landscape.
-RESOLVED = 0.05
 
 
 def _verdict(trust: dict[str, Any], source: str) -> str:

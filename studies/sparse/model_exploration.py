@@ -4,8 +4,8 @@ The blend of a few lines is right about the broad shape of a landscape and wrong
 depth of a basin narrower than the spacing.  After the lines, every simulation so far (line samples, the blend's
 minima) is a measurement of that error.  Each step here
 
-1. interpolates the residuals (simulation − blend) at every simulated design with a thin-plate spline, so the
-   corrected model ``blend + spline`` passes through every simulation and keeps the blend's shape between them;
+1. interpolates the residuals (simulation − blend) at every simulated design with a cubic radial-basis function,
+   so the corrected model passes through every simulation and keeps the blend's shape between them;
 2. minimises the corrected model over candidate designs (a scrambled Sobol cloud of the feasible region and a cloud
    around the best simulated design) that lie at least ``δ`` from every simulated design;
 3. simulates that minimiser.
@@ -22,10 +22,11 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-from scipy.interpolate import RBFInterpolator
 from scipy.optimize import minimize
 from scipy.spatial import cKDTree
 from scipy.stats import qmc
+
+from .trust_region import residual_model
 
 __all__ = ["DISTANCE_CYCLE", "corrected_model", "explore"]
 
@@ -72,17 +73,7 @@ def corrected_model(trend: Callable[[np.ndarray], np.ndarray] | None, Z: np.ndar
         t = np.asarray(trend(U), dtype=float)
         return np.clip(np.where(np.isfinite(t), t, hi_q), lo_q - 0.5 * scale, hi_q + 0.5 * scale)
 
-    residual = (q - base(Z)) / scale
-    correction: Callable[[np.ndarray], np.ndarray]
-    try:
-        # A tiny smoothing keeps the system solvable when two designs nearly coincide.
-        correction = RBFInterpolator(Z, residual, kernel="cubic", degree=1, smoothing=1e-10)
-    except np.linalg.LinAlgError:
-        try:  # too few designs off one plane for a linear tail
-            correction = RBFInterpolator(Z, residual, kernel="cubic", degree=0, smoothing=1e-10)
-        except np.linalg.LinAlgError:
-            def correction(U: np.ndarray) -> np.ndarray:
-                return np.zeros(len(np.atleast_2d(U)))
+    correction = residual_model(Z, (q - base(Z)) / scale, kernel="cubic")
 
     def model(U: np.ndarray) -> np.ndarray:
         U = np.atleast_2d(U)

@@ -152,10 +152,8 @@ def corrected_steps(space: ModelSpace, sampler: Sampler, model_stage: Stage, bud
     model = model_stage.model
     square = model.fit == "square"
     lower, span = space.box[:, 0], space.box[:, 1] - space.box[:, 0]
-    designs = [d for d, _ in sampler.history.values()]
+    X = np.array([d for d, _ in sampler.history.values()], dtype=float).reshape(-1, space.dim)
     values = np.array([v for _, v in sampler.history.values()], dtype=float)
-    Z = (np.array(designs, dtype=float).reshape(-1, space.dim) - lower) / span
-    inside = np.isfinite(values) & space.feasible(np.array(designs, dtype=float).reshape(-1, space.dim))
     n_before = len(sampler.history)
 
     def simulate(z: np.ndarray) -> float:
@@ -173,15 +171,17 @@ def corrected_steps(space: ModelSpace, sampler: Sampler, model_stage: Stage, bud
 
     progress, sampler.progress = sampler.progress, False
     try:
-        Z, q = explore(simulate, Z, values * values if square else values, trend, feasible, budget, seed, (0.0,),
+        Z, q = explore(simulate, (X - lower) / span, values * values if square else values, trend, feasible,
+                       budget, seed, (0.0,),
                        margins if space.problem.constraints else None,
                        patience=space.dim + 1 if patience is None else patience)
     finally:
         sampler.progress = progress
-    ok = np.isfinite(q) & feasible(Z)
-    ok[: inside.size] &= inside
+    # The designs as simulated (the earlier ones exactly, not their round trip through the unit cube).
+    X = np.vstack([X, lower + Z[n_before:] * span])
+    ok = np.isfinite(q) & space.feasible(X)
     j = int(np.flatnonzero(ok)[np.argmin(q[ok])])
-    x = lower + Z[j] * span
+    x = X[j]
     simulated = float(np.sqrt(max(q[j], 0.0)) if square else q[j])
     return Stage(name="corrected steps", plan=model_stage.plan, coverage=model_stage.coverage, model=model,
                  line_designs=[], line_values=[], candidate=x, predicted=float(model.predict(x)[0]),

@@ -110,7 +110,7 @@ def trust_region_steps(model: Callable[[np.ndarray], np.ndarray], simulate: Call
         residual = (q - base(U)) / scale
         # Thin-plate splines with a linear tail interpolate the residuals exactly and stay mild between samples; a
         # tiny smoothing keeps the system solvable when two designs nearly coincide.
-        correction = _residual_model(U, residual)
+        correction = residual_model(U, residual)
 
         def corrected(Uc: np.ndarray, correction=correction) -> np.ndarray:
             Uc = np.atleast_2d(Uc)
@@ -172,12 +172,16 @@ def trust_region_steps(model: Callable[[np.ndarray], np.ndarray], simulate: Call
     return TrustRegionResult(x=lower + u_best * span, value=q_best, n_steps=steps, radius=radius)
 
 
-def _residual_model(U: np.ndarray, residual: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
-    """Thin-plate spline of the residuals with a linear tail, a constant one when the designs span too few
-    dimensions for a plane (few lines, all samples in one plane), nothing when even that fails."""
+def residual_model(U: np.ndarray, residual: np.ndarray,
+                   kernel: str = "thin_plate_spline") -> Callable[[np.ndarray], np.ndarray]:
+    """Radial-basis interpolant of the residuals with a linear tail, a constant one when the designs span too few
+    dimensions for a plane (few lines, all samples in one plane), nothing when even that fails.
+
+    A tiny smoothing keeps the system solvable when two designs nearly coincide.
+    """
     for degree in (1, 0):
         try:
-            return RBFInterpolator(U, residual, kernel="thin_plate_spline", degree=degree, smoothing=1e-10)
+            return RBFInterpolator(U, residual, kernel=kernel, degree=degree, smoothing=1e-10)
         except np.linalg.LinAlgError:
             continue
     return lambda Uc: np.zeros(len(np.atleast_2d(Uc)))
