@@ -23,27 +23,27 @@ independent of the physics) and :mod:`mechopt.studies` (the engine that runs a s
 # pytest imports the checkout's root __init__.py as a plain file (no parent package) when the clone's folder name is
 # not a valid module name (e.g. /tmp/tmp.XYZ); then there is nothing to set up.
 if __package__:
-    from ._numba_cache import use_user_cache
+    from mechopt._numba_cache import use_user_cache
 
     use_user_cache()
 
-    from .errors import InfeasibleDesignError, InputError, MechoptError, StudyError
+    from mechopt.errors import InfeasibleDesignError, InputError, MechoptError, StudyError
 
 __version__ = "0.2.0"
 
 # The rest of the API is imported on first use (PEP 562): every worker process and every CLI call imports mechopt,
 # and the optimizers behind minimize() (scipy.stats, the baselines) cost seconds that a simulation does not need.
 _LAZY = {
-    "DesignProblem": "mechopt.studies.problem",
-    "Variable": "mechopt.studies.problem",
-    "minimize": "mechopt.studies.minimize",
-    "OptimizeResult": "mechopt.studies.result",
-    "load_study": "mechopt.studies.definition",
-    "available_studies": "mechopt.studies.definition",
-    "SparseOptions": "mechopt.studies.sparse.options",
-    "ObjectiveModel": "mechopt.studies.sparse.model",
-    "SampleStore": "mechopt.studies.store",
-    "register_mechanism": "mechopt.sim.registry",
+    "DesignProblem": "mechopt.optimize.problem",
+    "Variable": "mechopt.optimize.problem",
+    "minimize": "mechopt.optimize.minimize",
+    "OptimizeResult": "mechopt.optimize.result",
+    "load_study": "mechopt.studies.catalogue",
+    "available_studies": "mechopt.studies.catalogue",
+    "SparseOptions": "mechopt.optimize.sparse.options",
+    "ObjectiveModel": "mechopt.optimize.sparse.model",
+    "SampleStore": "mechopt.runs.store",
+    "register_mechanism": "mechopt.studies.registry",
 }
 
 __all__ = [  # noqa: RUF022 - the eager names first, then the lazy ones

@@ -10,9 +10,9 @@ import argparse
 import os
 import time
 
+from mechopt.optimize.ground_truth import compute_ground_truth
 from mechopt.sim.fourbar.analytic import analytic_batch
-from mechopt.studies.definition import load_study
-from mechopt.studies.ground_truth import compute_ground_truth
+from mechopt.studies.catalogue import load_study
 
 
 def main() -> None:
@@ -48,8 +48,8 @@ def basin_check(study, n_starts: int, seed: int = 5) -> str:
 
     import numpy as np
 
+    from mechopt.optimize.ground_truth import polish
     from mechopt.sim.fourbar.feasibility import feasible_mask
-    from mechopt.studies.ground_truth import polish
 
     rng = np.random.default_rng(seed)
     box = study.problem.bounds

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mechopt.studies.definition import load_study
+from mechopt.studies.catalogue import load_study
 
 SIM = "import json, sys\nd = json.load(open('design.json')) if '--files' in sys.argv else json.load(sys.stdin)\n" \
       "out = json.dumps({'f': (d['a'] - 1) ** 2 + d['b']})\n" \

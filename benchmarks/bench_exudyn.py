@@ -31,7 +31,7 @@ from mechopt.sim.fourbar.feasibility import check_feasibility
 from mechopt.sim.fourbar.kinematics import crank_angle
 from mechopt.sim.fourbar.pymunk_engine import simulate_pymunk
 from mechopt.sim.fourbar.simulate import simulate
-from mechopt.studies.definition import load_study
+from mechopt.studies.catalogue import load_study
 
 
 def _toggle_margin_designs(mech, inside, outside, n):

@@ -17,10 +17,10 @@ import time
 import numpy as np
 
 from mechopt.errors import InfeasibleDesignError
+from mechopt.optimize.baselines import BASELINES, CountedProblem
 from mechopt.sim.fourbar.analytic import simulate_analytic
 from mechopt.sim.fourbar.feasibility import check_feasibility
-from mechopt.studies.baselines import BASELINES, CountedProblem
-from mechopt.studies.definition import load_study
+from mechopt.studies.catalogue import load_study
 
 #: Brute-force optimum of the ventilator (analytic engine, 1 mm grid + SLSQP polish), N·m.
 T_TRUE = 1.758244

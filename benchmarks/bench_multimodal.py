@@ -1,8 +1,8 @@
-"""Benchmark of the global sparse strategy (studies/sparse_global.py) on the multimodal suite and the ventilator.
+"""Benchmark of the global sparse strategy (optimize/sparse_global.py) on the multimodal suite and the ventilator.
 
 For every suite function (studies/test_functions.py) and budget, 10 seeds of
 
-* ``sparse``: :func:`mechopt.studies.sparse_global.global_search` (lines, blend, basins, steps on the corrected
+* ``sparse``: :func:`mechopt.optimize.sparse_global.global_search` (lines, blend, basins, steps on the corrected
   blend);
 * ``sparse-model``: the same without the steps (global lines, their blend's basins simulated): what the
   line model alone achieves;
@@ -31,8 +31,8 @@ import numpy as np
 if __package__ in (None, ""):
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from mechopt.studies.budget import CountedProblem  # noqa: E402
-from mechopt.studies.sparse_global import global_search  # noqa: E402
+from mechopt.optimize.budget import CountedProblem  # noqa: E402
+from mechopt.optimize.sparse_global import global_search  # noqa: E402
 from mechopt.studies.test_functions import SUITE, TestFunction  # noqa: E402
 
 #: Issue 15's bar is set at 300 evaluations in 3-D and 150 in 2-D: larger budgets are not run in 2-D.
@@ -49,7 +49,7 @@ def run_sparse(p: TestFunction, budget: int, seed: int, **options) -> tuple[floa
 
 
 def run_de(p: TestFunction, budget: int, seed: int) -> tuple[float, np.ndarray, int]:
-    from mechopt.studies.baselines.differential_evolution import minimize_differential_evolution
+    from mechopt.optimize.baselines.differential_evolution import minimize_differential_evolution
 
     cons = (lambda x: p.constraint_margins(x[None, :])[0]) if p.constraints else None
     prob = CountedProblem(lambda x: float(p(x[None, :])[0]), p.bounds, budget, cons)
@@ -58,7 +58,7 @@ def run_de(p: TestFunction, budget: int, seed: int) -> tuple[float, np.ndarray, 
 
 
 def run_ego(p: TestFunction, budget: int, seed: int) -> tuple[float, np.ndarray, int]:
-    from mechopt.studies.baselines.smt_ego import minimize_smt_ego
+    from mechopt.optimize.baselines.smt_ego import minimize_smt_ego
 
     cons = (lambda x: p.constraint_margins(x[None, :])[0]) if p.constraints else None
     prob = CountedProblem(lambda x: float(p(x[None, :])[0]), p.bounds, budget, cons)
@@ -110,7 +110,7 @@ def suite_table(budgets: list[int], n_seeds: int, ego: bool) -> None:
 
 def ventilator(budgets: list[int], n_seeds: int) -> None:
     from mechopt.sim.fourbar.analytic import analytic_batch
-    from mechopt.studies.definition import load_study
+    from mechopt.studies.catalogue import load_study
 
     problem = load_study("ventilator", {"engine": "analytic"}).problem
     mech = problem.mechanism

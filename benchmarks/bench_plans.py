@@ -17,14 +17,14 @@ from pathlib import Path
 
 import numpy as np
 
-from mechopt.studies.definition import load_study
-from mechopt.studies.ground_truth import load_or_compute
-from mechopt.studies.run import study_options
-from mechopt.studies.sparse.sampler import Sampler
-from mechopt.studies.sparse.space import ModelSpace
-from mechopt.studies.sparse.stage import build_stage
-from mechopt.studies.sparse.validate import validate
-from mechopt.studies.store import SampleStore
+from mechopt.cli.run_study import study_options
+from mechopt.optimize.ground_truth import load_or_compute
+from mechopt.optimize.sparse.sampler import Sampler
+from mechopt.optimize.sparse.space import ModelSpace
+from mechopt.optimize.sparse.stage import build_stage
+from mechopt.optimize.sparse.validate import validate
+from mechopt.runs.store import SampleStore
+from mechopt.studies.catalogue import load_study
 
 #: (label, options changed from the study's defaults, the toggle relaxation of the lines in degrees)
 CONFIGS = [

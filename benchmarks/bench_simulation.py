@@ -17,7 +17,7 @@ import numpy as np
 from mechopt.sim.fourbar.analytic import analytic_batch, simulate_analytic
 from mechopt.sim.fourbar.feasibility import feasible_mask
 from mechopt.sim.fourbar.pymunk_engine import simulate_pymunk
-from mechopt.studies.definition import load_study
+from mechopt.studies.catalogue import load_study
 
 
 def main() -> None:

@@ -12,7 +12,7 @@ import argparse
 import json
 from pathlib import Path
 
-from mechopt.studies.compare import headline, plot_headline
+from mechopt.cli.compare import headline, plot_headline
 
 
 def main() -> None:

@@ -15,9 +15,9 @@ import argparse
 import json
 from pathlib import Path
 
-from mechopt.studies import compare as cmp
-from mechopt.studies.definition import load_study
-from mechopt.studies.ground_truth import GroundTruth
+from mechopt.cli import compare as cmp
+from mechopt.optimize.ground_truth import GroundTruth
+from mechopt.studies.catalogue import load_study
 
 
 def main() -> None:

@@ -1,6 +1,6 @@
 """Multimodal test functions as design problems: the suite on which the global strategy is measured.
 
-Each problem is a :class:`~mechopt.studies.problem.DesignProblem` with its known global minimum ``f_min``, every
+Each problem is a :class:`~mechopt.optimize.problem.DesignProblem` with its known global minimum ``f_min``, every
 global minimiser ``x_min`` (one row per minimiser: Branin and the six-hump camel have several), the value of the
 second-best local minimum ``f_second`` and the range of the function over the (feasible) box, ``f_range`` = max − min,
 measured once on a dense grid (:func:`dense_grid_range` with the grid recorded in ``range_grid``; the printed
@@ -21,7 +21,7 @@ from typing import ClassVar
 import numpy as np
 from scipy.optimize import minimize
 
-from .problem import DesignProblem, Variable
+from mechopt.optimize.problem import DesignProblem, Variable
 
 __all__ = [
     "SUITE",

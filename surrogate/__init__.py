@@ -6,13 +6,13 @@ model.  It works on generic coordinates X in R^d (d = 3 for the four-bar; the ca
 and does not depend on the simulation code.
 """
 
-from .blending import ChebyshevBlend
-from .errors import SurrogateError, SurrogateWarning
-from .exponential_fit import ExponentialFit, fit_exponential
-from .lines import LineHull, LinePlan, normal_basis
-from .model import SparseExponentialModel
-from .planner import PlanResult, coverage, plan_lines
-from .search import HullGrid, SearchResult, exhaustive_search, grid_minimum, hull_grid
+from mechopt.surrogate.blending import ChebyshevBlend
+from mechopt.surrogate.errors import SurrogateError, SurrogateWarning
+from mechopt.surrogate.exponential_fit import ExponentialFit, fit_exponential
+from mechopt.surrogate.lines import LineHull, LinePlan, normal_basis
+from mechopt.surrogate.model import SparseExponentialModel
+from mechopt.surrogate.planner import PlanResult, coverage, plan_lines
+from mechopt.surrogate.search import HullGrid, SearchResult, exhaustive_search, grid_minimum, hull_grid
 
 __all__ = [
     "ChebyshevBlend",

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.ndimage import minimum_filter
 
-from .errors import SurrogateError
+from mechopt.surrogate.errors import SurrogateError
 
 
 @dataclass(frozen=True, eq=False)

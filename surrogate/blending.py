@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from .errors import SurrogateError
+from mechopt.surrogate.errors import SurrogateError
 
 _RANK_TOL = 1e-9
 

@@ -45,7 +45,7 @@ from typing import Any
 
 import numpy as np
 
-from .errors import SurrogateError, SurrogateWarning
+from mechopt.surrogate.errors import SurrogateError, SurrogateWarning
 
 METHODS = ("matrix_pencil", "esprit")
 SOLVERS = ("ls", "tls")

@@ -20,9 +20,9 @@ from typing import Any
 
 import numpy as np
 
-from .blending import ChebyshevBlend
-from .errors import SurrogateError
-from .model import SparseExponentialModel
+from mechopt.surrogate.blending import ChebyshevBlend
+from mechopt.surrogate.errors import SurrogateError
+from mechopt.surrogate.model import SparseExponentialModel
 
 
 @dataclass(frozen=True, eq=False)

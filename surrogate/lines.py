@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
-from .errors import SurrogateError
+from mechopt.surrogate.errors import SurrogateError
 
 FeasiblePredicate = Callable[[np.ndarray], np.ndarray]
 

@@ -24,10 +24,10 @@ from typing import Any
 
 import numpy as np
 
-from .blending import ChebyshevBlend
-from .errors import SurrogateError, SurrogateWarning
-from .exponential_fit import METHODS, SOLVERS, ExponentialFit, fit_exponential
-from .lines import LineHull, LinePlan
+from mechopt.surrogate.blending import ChebyshevBlend
+from mechopt.surrogate.errors import SurrogateError, SurrogateWarning
+from mechopt.surrogate.exponential_fit import METHODS, SOLVERS, ExponentialFit, fit_exponential
+from mechopt.surrogate.lines import LineHull, LinePlan
 
 _FORMAT = "mechopt.surrogate.SparseExponentialModel"
 _VERSION = 1

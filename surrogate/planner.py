@@ -32,8 +32,8 @@ from typing import Any
 import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
-from .errors import SurrogateError
-from .lines import FeasiblePredicate, LinePlan, normal_basis
+from mechopt.surrogate.errors import SurrogateError
+from mechopt.surrogate.lines import FeasiblePredicate, LinePlan, normal_basis
 
 _SHRINKS = (0.9, 0.75, 0.6)
 _PHASES = (0.0, 0.5)

@@ -23,9 +23,9 @@ from numba import njit, prange
 from scipy.optimize import minimize
 from scipy.spatial import ConvexHull, QhullError
 
-from .errors import SurrogateError
-from .lines import FeasiblePredicate
-from .model import SparseExponentialModel
+from mechopt.surrogate.errors import SurrogateError
+from mechopt.surrogate.lines import FeasiblePredicate
+from mechopt.surrogate.model import SparseExponentialModel
 
 
 @dataclass(eq=False)

@@ -15,7 +15,7 @@ def _config() -> dict:
 def test_every_subpackage_is_listed_and_nothing_else():
     listed = set(_config()["tool"]["setuptools"]["packages"])
     found = {"mechopt"}
-    for top in ("sim", "surrogate", "studies"):
+    for top in ("sim", "surrogate", "optimize", "runs", "studies", "report", "cli"):
         for init in (ROOT / top).rglob("__init__.py"):
             found.add("mechopt." + ".".join(init.parent.relative_to(ROOT).parts))
     assert listed == found, f"listed only: {sorted(listed - found)}; not listed: {sorted(found - listed)}"
@@ -31,4 +31,4 @@ def test_every_packaged_study_file_and_its_data_are_package_data():
 
 
 def test_the_console_script_points_into_mechopt():
-    assert _config()["project"]["scripts"]["mechopt"] == "mechopt.studies.cli:main"
+    assert _config()["project"]["scripts"]["mechopt"] == "mechopt.cli.main:main"

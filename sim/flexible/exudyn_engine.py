@@ -20,10 +20,9 @@ import time
 import numpy as np
 
 from mechopt.errors import InputError
-
-from .kinematics import rigid_motion
-from .parameters import FlexibleSliderCrank
-from .response import Response
+from mechopt.sim.flexible.kinematics import rigid_motion
+from mechopt.sim.flexible.parameters import FlexibleSliderCrank
+from mechopt.sim.flexible.response import Response
 
 __all__ = ["simulate_exudyn"]
 

@@ -23,10 +23,10 @@ import numpy as np
 from numba import njit
 from scipy.linalg import eigh
 
-from .beam import rod_matrices
-from .kinematics import rigid_motion, rigid_state
-from .parameters import FlexibleSliderCrank
-from .response import Response
+from mechopt.sim.flexible.beam import rod_matrices
+from mechopt.sim.flexible.kinematics import rigid_motion, rigid_state
+from mechopt.sim.flexible.parameters import FlexibleSliderCrank
+from mechopt.sim.flexible.response import Response
 
 __all__ = ["natural_frequencies", "simulate_modal"]
 

@@ -41,14 +41,13 @@ import numpy as np
 from numba import njit
 
 from mechopt.errors import InputError, MechoptError
-
-from .analytic import MM
-from .feasibility import require_movable
-from .kinematics import _crank_kernel, check_design, crank_angle
-from .load import _load_at
-from .mechanism import FourBar
-from .motion import _psi_at
-from .result import SimulationResult, rms_over_cycle
+from mechopt.sim.fourbar.analytic import MM
+from mechopt.sim.fourbar.feasibility import require_movable
+from mechopt.sim.fourbar.kinematics import _crank_kernel, check_design, crank_angle
+from mechopt.sim.fourbar.load import _load_at
+from mechopt.sim.fourbar.mechanism import FourBar
+from mechopt.sim.fourbar.motion import _psi_at
+from mechopt.sim.fourbar.result import SimulationResult, rms_over_cycle
 
 #: Default steps per cycle: a 2 ms step for the ventilator's 0.4 s cycle.
 N_STEPS = 200

@@ -12,10 +12,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from mechopt.errors import InputError
-
-from .kinematics import BRANCH_SUBTRACT, validate_pivot
-from .load import RockerLoad
-from .motion import MotionLaw
+from mechopt.sim.fourbar.kinematics import BRANCH_SUBTRACT, validate_pivot
+from mechopt.sim.fourbar.load import RockerLoad
+from mechopt.sim.fourbar.motion import MotionLaw
 
 
 @dataclass(frozen=True)

@@ -16,11 +16,10 @@ from typing import Any
 import numpy as np
 
 from mechopt.errors import InputError
-from mechopt.studies.problem import DesignProblem, Variable
-
-from .feasibility import MARGIN_NAMES, N_CHECK, check_feasibility, constraint_margins
-from .mechanism import FourBar
-from .simulate import ENGINES, simulate
+from mechopt.optimize.problem import DesignProblem, Variable
+from mechopt.sim.fourbar.feasibility import MARGIN_NAMES, N_CHECK, check_feasibility, constraint_margins
+from mechopt.sim.fourbar.mechanism import FourBar
+from mechopt.sim.fourbar.simulate import ENGINES, simulate
 
 __all__ = ["ENGINE_VERSIONS", "FourBarProblem"]
 
@@ -96,7 +95,7 @@ class FourBarProblem(DesignProblem):
 
     def evaluate_batch(self, X: np.ndarray) -> np.ndarray:
         """T_RMS (N·m) of many designs (n, 3) by the analytic engine (numba), for brute-force ground truths."""
-        from .analytic import analytic_batch
+        from mechopt.sim.fourbar.analytic import analytic_batch
 
         t_rms, _ = analytic_batch(np.atleast_2d(np.asarray(X, dtype=float)), self.mechanism, check=False)
         return t_rms
@@ -149,7 +148,7 @@ class FourBarProblem(DesignProblem):
 
     def figures(self, designs: Mapping[str, np.ndarray], out: Path) -> dict[str, Path]:
         """Torque over the cycle of every design, the mechanisms at ψ_start and ψ_end, the optimum's cycle (GIF)."""
-        from .figures import animate_cycle, plot_mechanisms, plot_torque_comparison
+        from mechopt.sim.fourbar.figures import animate_cycle, plot_mechanisms, plot_torque_comparison
 
         results = {name: simulate(np.asarray(x, float), self.mechanism, engine=self.engine)
                    for name, x in designs.items()}

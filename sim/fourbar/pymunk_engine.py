@@ -31,12 +31,12 @@ import time
 import numpy as np
 import pymunk
 
-from .analytic import MM
-from .feasibility import require_movable
-from .kinematics import check_design, crank_angle
-from .load import _load_at
-from .mechanism import FourBar
-from .result import SimulationResult, rms_over_cycle
+from mechopt.sim.fourbar.analytic import MM
+from mechopt.sim.fourbar.feasibility import require_movable
+from mechopt.sim.fourbar.kinematics import check_design, crank_angle
+from mechopt.sim.fourbar.load import _load_at
+from mechopt.sim.fourbar.mechanism import FourBar
+from mechopt.sim.fourbar.result import SimulationResult, rms_over_cycle
 
 #: Moment of inertia of the stator (kg·m²): large, so that it barely turns within one step, yet its angular velocity
 #: keeps ~13 significant digits of the motor's reaction impulse.

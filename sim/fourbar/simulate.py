@@ -5,12 +5,11 @@ from __future__ import annotations
 import numpy as np
 
 from mechopt.errors import InputError
-
-from .analytic import simulate_analytic
-from .exudyn_engine import simulate_exudyn
-from .mechanism import FourBar
-from .pymunk_engine import simulate_pymunk
-from .result import SimulationResult
+from mechopt.sim.fourbar.analytic import simulate_analytic
+from mechopt.sim.fourbar.exudyn_engine import simulate_exudyn
+from mechopt.sim.fourbar.mechanism import FourBar
+from mechopt.sim.fourbar.pymunk_engine import simulate_pymunk
+from mechopt.sim.fourbar.result import SimulationResult
 
 ENGINES = ("pymunk", "analytic", "exudyn")
 

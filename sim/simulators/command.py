@@ -34,7 +34,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .outputs import SimulatorFailure, checked_outputs, file_digest, resolve_entry, text_digest
+from mechopt.sim.simulators.outputs import SimulatorFailure, checked_outputs, file_digest, resolve_entry, text_digest
 
 __all__ = ["EXCHANGES", "KEEP", "CommandSimulator"]
 

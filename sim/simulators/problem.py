@@ -15,7 +15,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from mechopt.studies.problem import DesignProblem, Variable
+from mechopt.optimize.problem import DesignProblem, Variable
 
 __all__ = ["ExternalProblem", "Simulator"]
 
@@ -45,7 +45,7 @@ class ExternalProblem(DesignProblem):
     objective : str
         The output minimised (one of ``simulator.outputs``).
     fit : str
-        ``"square"`` or ``"value"`` (see :class:`~mechopt.studies.problem.DesignProblem`).
+        ``"square"`` or ``"value"`` (see :class:`~mechopt.optimize.problem.DesignProblem`).
     """
 
     def __init__(self, base: DesignProblem, simulator: Simulator, objective: str, fit: str) -> None:

@@ -18,8 +18,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from mechopt.errors import StudyError
-
-from .outputs import SimulatorFailure, checked_outputs, file_digest
+from mechopt.sim.simulators.outputs import SimulatorFailure, checked_outputs, file_digest
 
 __all__ = ["CallableSimulator", "module_file", "split_target"]
 

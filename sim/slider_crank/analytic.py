@@ -19,10 +19,10 @@ import time
 import numpy as np
 from numba import njit
 
-from .feasibility import COLUMNS, require_assemblable
-from .kinematics import _slider_kernel, check_design, slider_position
-from .mechanism import SliderCrank
-from .result import SliderCrankResult
+from mechopt.sim.slider_crank.feasibility import COLUMNS, require_assemblable
+from mechopt.sim.slider_crank.kinematics import _slider_kernel, check_design, slider_position
+from mechopt.sim.slider_crank.mechanism import SliderCrank
+from mechopt.sim.slider_crank.result import SliderCrankResult
 
 MM = 1e-3  # m per mm: the single place where the user's mm become the dynamics' metres
 

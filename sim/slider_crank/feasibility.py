@@ -14,8 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from mechopt.errors import InfeasibleDesignError, InputError
-
-from .kinematics import transmission_extremes
+from mechopt.sim.slider_crank.kinematics import transmission_extremes
 
 COLUMNS = ("assembly_mm", "ta_low_deg", "ta_high_deg")
 

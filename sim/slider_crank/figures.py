@@ -15,8 +15,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from PIL import Image  # noqa: E402
 
-from .kinematics import joint_positions  # noqa: E402
-from .limits import limit_positions  # noqa: E402
+from mechopt.sim.slider_crank.kinematics import joint_positions  # noqa: E402
+from mechopt.sim.slider_crank.limits import limit_positions  # noqa: E402
 
 
 def _draw_pose(ax, design, theta, style, label=None):

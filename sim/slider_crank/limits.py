@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .kinematics import BRANCH_RIGHT, check_branch
+from mechopt.sim.slider_crank.kinematics import BRANCH_RIGHT, check_branch
 
 
 def _arrays(r, l, h):

@@ -12,9 +12,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from mechopt.errors import InputError
-
-from .kinematics import BRANCH_RIGHT, check_branch
-from .motion import CrankMotion
+from mechopt.sim.slider_crank.kinematics import BRANCH_RIGHT, check_branch
+from mechopt.sim.slider_crank.motion import CrankMotion
 
 
 @dataclass(frozen=True)

@@ -28,12 +28,11 @@ import numpy as np
 import pymunk
 
 from mechopt.errors import InputError
-
-from .analytic import MM, rms_over_cycle
-from .feasibility import COLUMNS, require_assemblable
-from .kinematics import _slider_kernel, check_design
-from .mechanism import SliderCrank
-from .result import SliderCrankResult
+from mechopt.sim.slider_crank.analytic import MM, rms_over_cycle
+from mechopt.sim.slider_crank.feasibility import COLUMNS, require_assemblable
+from mechopt.sim.slider_crank.kinematics import _slider_kernel, check_design
+from mechopt.sim.slider_crank.mechanism import SliderCrank
+from mechopt.sim.slider_crank.result import SliderCrankResult
 
 #: Moment of inertia of the stator (kg·m²): large, so it barely turns within a step, yet its angular velocity keeps
 #: ~13 significant digits of the motor's reaction impulse.

@@ -32,7 +32,7 @@ import numpy as np
 
 import mechopt
 from mechopt.errors import InfeasibleDesignError
-from mechopt.studies.definition import STUDIES_DIR
+from mechopt.studies.catalogue import STUDIES_DIR
 
 NAMES = ("oa", "ab", "bc")  # |OA|, |AB|, |BC| in mm
 

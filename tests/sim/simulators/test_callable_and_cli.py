@@ -9,11 +9,11 @@ import sys
 import numpy as np
 import pytest
 
-from mechopt.studies.cli import main
-from mechopt.studies.definition import load_study
-from mechopt.studies.executors import make_executor
-from mechopt.studies.sampling import sample_designs
-from mechopt.studies.store import SampleStore
+from mechopt.cli.main import main
+from mechopt.runs.executors import make_executor
+from mechopt.runs.sampling import sample_designs
+from mechopt.runs.store import SampleStore
+from mechopt.studies.catalogue import load_study
 
 MODULE = '''
 import math

@@ -20,10 +20,10 @@ import numpy as np
 import pytest
 
 from mechopt.errors import StudyError
-from mechopt.studies.definition import load_study
-from mechopt.studies.executors import make_executor
-from mechopt.studies.sampling import sample_designs
-from mechopt.studies.store import SampleStore, design_key
+from mechopt.runs.executors import make_executor
+from mechopt.runs.sampling import sample_designs
+from mechopt.runs.store import SampleStore, design_key
+from mechopt.studies.catalogue import load_study
 
 # f has its minimum 1 at (1.3, 0.7); special values of a (or b) make the simulator misbehave in one way each.
 SIM = r'''
@@ -224,10 +224,10 @@ def test_a_bad_simulator_section_is_a_one_line_study_error(tmp_path, simulator, 
 
 KILL_SCRIPT = r'''
 import json, sys
-from mechopt.studies.definition import load_study
-from mechopt.studies.executors import make_executor
-from mechopt.studies.sampling import sample_designs
-from mechopt.studies.store import SampleStore
+from mechopt.studies.catalogue import load_study
+from mechopt.runs.executors import make_executor
+from mechopt.runs.sampling import sample_designs
+from mechopt.runs.store import SampleStore
 if __name__ == "__main__":  # the worker processes import this module: no run there
     problem = load_study(sys.argv[1]).problem
     with SampleStore(sys.argv[2]) as store, make_executor(workers=2) as ex:

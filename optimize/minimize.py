@@ -1,0 +1,204 @@
+"""``mechopt.minimize``: one entry point for the sparse pipeline and every baseline, on any design problem."""
+
+from __future__ import annotations
+
+import contextlib
+import tempfile
+import time
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from mechopt.errors import InfeasibleDesignError, InputError
+from mechopt.optimize.problem import DesignProblem
+from mechopt.optimize.result import OptimizeResult
+from mechopt.optimize.sparse.options import SparseOptions
+from mechopt.optimize.sparse.pipeline import run_pipeline
+from mechopt.optimize.sparse.sampler import Sampler
+from mechopt.optimize.sparse.space import ModelSpace
+from mechopt.optimize.sparse.trust import study_trust
+from mechopt.optimize.sparse.validate import validate
+from mechopt.runs.executors import make_executor
+from mechopt.runs.store import SampleStore
+
+__all__ = ["METHODS", "minimize"]
+
+#: ``"sparse"``: the pipeline of paper 002 (global model, confirmation, local refinement) — for smooth landscapes;
+#: ``"sparse-global"``: the same lines and blend made global on multimodal ones (basins of the blend and of its
+#: leave-one-line-out uncertainty simulated, then steps on the blend corrected by every simulation;
+#: :mod:`mechopt.optimize.sparse_global`).  Every
+#: name of :data:`mechopt.optimize.baselines.BASELINES` is a method too.
+METHODS = ("sparse", "sparse-global")
+
+
+def _baselines() -> dict[str, Callable[..., Any]]:
+    from mechopt.optimize.baselines import BASELINES
+
+    return BASELINES
+
+
+def _check_arguments(problem: Any, budget: Any, method: Any, seed: Any, workers: Any) -> None:
+    if not isinstance(problem, DesignProblem):
+        raise InputError(f"problem must be a mechopt.DesignProblem, got {type(problem).__name__}")
+    problem.check()
+    if isinstance(budget, bool) or not isinstance(budget, int | np.integer) or budget < 3:
+        raise InputError(f"budget = {budget!r}: expected a whole number of simulations >= 3")
+    if not callable(method) and method not in METHODS and method not in _baselines():
+        raise InputError(f"method = {method!r}; expected 'sparse', one of {', '.join(_baselines())} or a callable")
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+        raise InputError(f"seed = {seed!r}: expected a whole number >= 0")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise InputError(f"workers = {workers!r}: expected a whole number >= 1")
+    if method in METHODS and not 2 <= problem.dim <= 4:
+        raise InputError(f"the sparse method handles 2 to 4 design variables; {problem.name!r} has {problem.dim}")
+
+
+def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[..., Any] = "sparse", seed: int = 0,
+             workers: int | None = 1, store: str | Path | SampleStore | None = None,
+             options: Mapping[str, Any] | SparseOptions | None = None, scheduler: Any = None,
+             progress: bool = False, retry_failed: bool = False,
+             log: Callable[[str], None] | None = None) -> OptimizeResult:
+    """Minimise a design problem's objective within a budget of simulations.
+
+    Parameters
+    ----------
+    problem : DesignProblem
+        Variables, constraints, evaluator and objective.
+    budget : int
+        Most simulations the method may ask for (validation simulations of the sparse method come on top).
+    method : str or callable
+        ``"sparse"`` (the line-sampled sparse model of paper 002, then a local search on the simulator),
+        ``"sparse-global"`` (for multimodal objectives: the lines' blend, its basins, then steps on the blend
+        corrected by every simulation; :mod:`mechopt.optimize.sparse_global`), a
+        baseline's name (``"slsqp"``, ``"differential_evolution"``...) or a callable
+        ``f(counted_problem, seed) -> scipy OptimizeResult``.
+    seed : int
+        Seed of every random choice.
+    workers : int, optional
+        Local processes evaluating designs; 1 (default) runs in this process.  None uses every core.
+    store : path or SampleStore, optional
+        SQLite sample store: designs found there (same problem fingerprint) are not simulated again, and every new
+        one is committed as soon as it is known.  Default: a temporary store, discarded at the end.
+    options : mapping or SparseOptions, optional
+        Options of the sparse method (``SparseOptions.help()``); defaults are scaled to the budget.
+        ``validation_lines`` defaults to 0 here (no held-out lines).
+    scheduler : str, optional
+        A Dask scheduler address to evaluate on instead of local processes.
+    progress : bool
+        Progress bars with rate and ETA.
+    retry_failed : bool
+        Simulate again designs whose earlier simulation failed.
+    log : callable, optional
+        Where progress lines go (default: nowhere).
+
+    Returns
+    -------
+    OptimizeResult
+        ``x``, ``fun``, ``outputs``, ``nfev``, ``success``, ``message`` and, for the sparse method, ``model``,
+        ``stages`` and ``validation``.
+
+    Raises
+    ------
+    InputError
+        A bad argument, before any simulation.
+    """
+    _check_arguments(problem, budget, method, seed, workers)
+    if isinstance(options, SparseOptions):
+        opts = options.replace(budget=int(budget), seed=int(seed))
+    else:
+        given = dict(options or {})
+        given.setdefault("validation_lines", 0)
+        opts = SparseOptions.for_budget(int(budget), problem.dim, int(seed), **given)
+    log = log or (lambda _line: None)
+    t0 = time.perf_counter()
+    with contextlib.ExitStack() as stack:
+        if isinstance(store, SampleStore):
+            db = store
+        else:
+            if store is None:
+                folder = stack.enter_context(tempfile.TemporaryDirectory(prefix="mechopt-"))
+                store = Path(folder) / "samples.sqlite"
+            db = stack.enter_context(SampleStore(store))
+        executor = stack.enter_context(make_executor(workers=workers, scheduler=scheduler))
+        sampler = Sampler(problem, db, executor, progress, retry_failed)
+        if method == "sparse":
+            result = _sparse(problem, opts, sampler, log)
+        elif method == "sparse-global":
+            result = _sparse_global(problem, int(budget), int(seed), sampler)
+        else:
+            fn = method if callable(method) else _baselines()[method]
+            result = _baseline(problem, fn, int(budget), int(seed), sampler,
+                               method if isinstance(method, str) else getattr(fn, "__name__", "custom"))
+        result["sampling"] = sampler.summary()
+        result["nnew"], result["nreused"] = sampler.n_computed, sampler.n_cached
+        result["nfailed"] = len(sampler.failures)
+        if result.success:
+            record = sampler.records(np.asarray(result.x)[None, :], desc="optimum")[0]
+            result["outputs"] = dict(record.outputs)
+    result["wall_time_s"] = time.perf_counter() - t0
+    return result
+
+
+def _sparse(problem: DesignProblem, opts: SparseOptions, sampler: Sampler, log: Callable[[str], None]):
+    space = ModelSpace(problem)
+    pipeline = run_pipeline(space, opts, sampler, log=log)
+    nfev = len(sampler.designs)
+    validation = None
+    if opts.validation_lines > 0:
+        validation = validate(pipeline.stages[0].model, space, sampler, opts.validation_lines,
+                              opts.validation_points, opts.seed, f_min=pipeline.fun)
+    success = bool(np.isfinite(pipeline.fun) and space.feasible(pipeline.x)[0])
+    return OptimizeResult(x=pipeline.x, fun=pipeline.fun, nfev=nfev, success=success, message=pipeline.message,
+                          method="sparse", model=pipeline.stages[0].model, stages=pipeline.stages,
+                          pipeline=pipeline, validation=validation, options=opts,
+                          trust=study_trust(pipeline.stages[0], pipeline.best, validation))
+
+
+def _sparse_global(problem: DesignProblem, budget: int, seed: int, sampler: Sampler) -> OptimizeResult:
+    from mechopt.optimize.sparse_global import global_search
+
+    def evaluate(X: np.ndarray) -> np.ndarray:
+        return sampler(np.atleast_2d(X), desc="sparse-global")
+
+    def margins(X: np.ndarray) -> np.ndarray:
+        return problem.constraint_margins(np.atleast_2d(X))
+
+    res = global_search(evaluate, problem.bounds, problem.feasible, problem.sampleable, budget=budget,
+                        fit=problem.fit, seed=seed, margins=margins if problem.constraints else None)
+    success = bool(np.all(np.isfinite(res.x)) and problem.feasible(res.x)[0])
+    trust = dict(res.trust)
+    return OptimizeResult(x=np.asarray(res.x, dtype=float), fun=float(res.fun), nfev=len(sampler.designs),
+                          success=success, message=str(trust.get("verdict", "")), method="sparse-global",
+                          model=None, models=res.models, stages=[], validation=None, trust=trust)
+
+
+def _baseline(problem: DesignProblem, fn: Callable[..., Any], budget: int, seed: int, sampler: Sampler,
+              name: str) -> OptimizeResult:
+    from mechopt.optimize.budget import CountedProblem
+
+    def objective(x: np.ndarray) -> float:
+        value = float(sampler(np.asarray(x, dtype=float)[None, :], desc=name)[0])
+        if not np.isfinite(value):
+            raise InfeasibleDesignError(f"the simulation of {problem.describe(x)} did not succeed")
+        return value
+
+    def margins(X: np.ndarray) -> np.ndarray:
+        X = np.asarray(X, dtype=float)
+        M = problem.constraint_margins(np.atleast_2d(X))
+        return M[0] if X.ndim == 1 else M
+
+    progress, sampler.progress = sampler.progress, False
+    counted = CountedProblem(objective, problem.bounds, budget, margins if problem.constraints else None,
+                             failure_errors=(InfeasibleDesignError,), vectorized_constraints=True)
+    try:
+        res = fn(counted, seed)
+    finally:
+        sampler.progress = progress
+    x = counted.best_x
+    success = x is not None
+    return OptimizeResult(x=np.asarray(x if success else res.x, dtype=float), fun=float(counted.best_f) if success
+                          else float("nan"), nfev=counted.nfev, success=success,
+                          message=str(getattr(res, "message", "")) or ("done" if success else "no feasible design"),
+                          method=name, model=None, stages=[], validation=None)

@@ -1,0 +1,331 @@
+"""The design-problem protocol: what mechopt needs to know of a mechanism, a study or a user's own simulator.
+
+A problem is a small class, in the manner of SMT's ``Problem``: it declares its design variables (name, bounds,
+unit), its constraints as named, vectorised margins (>= 0 feasible), the outputs its evaluator returns for one
+design, the objective (one of those outputs, and whether the sparse model fits it or its square) and the settings
+that change an output (hashed into the fingerprint that keys the sample store).  Everything else — planning lines,
+sampling through the store, fitting, searching, refining, validating, reporting — is mechopt's and works for any
+problem with 2 to 4 variables.
+
+Example
+-------
+>>> import numpy as np, mechopt
+>>> class Bowl(mechopt.DesignProblem):
+...     name = "bowl"
+...     variables = (mechopt.Variable("a", 0.0, 2.0), mechopt.Variable("b", 0.0, 2.0))
+...     constraints = ("disc",)
+...     outputs = ("f",)
+...     objective = "f"
+...     def margins(self, X):
+...         return (1.5**2 - X[:, 0] ** 2 - X[:, 1] ** 2)[:, None]
+...     def evaluate(self, x):
+...         return {"f": 1.0 + (x[0] - 1.0) ** 2 + (x[1] - 0.5) ** 2}
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+
+from mechopt.errors import InputError
+from mechopt.runs.fingerprint import fingerprint
+
+__all__ = ["FITS", "DesignProblem", "Variable", "as_design_array"]
+
+#: What the sparse model fits along its lines: the objective itself, or its square (smoother for an RMS value).
+FITS = ("value", "square")
+
+
+@dataclass(frozen=True)
+class Variable:
+    """One design variable.
+
+    Parameters
+    ----------
+    name : str
+        Identifier used everywhere a user sees a design (CLI, result.json, reports, axis labels), e.g. ``"oa"``.
+    lower, upper : float
+        Bounds of the region of interest, in ``unit``.
+    unit : str
+        Unit of the variable (``"mm"``, ``"rad"``, ``""`` for a ratio).
+    label : str
+        Symbol for plots and tables (``"|OA|"``); default the name.
+    """
+
+    name: str
+    lower: float
+    upper: float
+    unit: str = ""
+    label: str = ""
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name.isidentifier():
+            raise InputError(f"variable name {self.name!r}: expected an identifier such as 'oa'")
+        for key in ("lower", "upper"):
+            value = getattr(self, key)
+            if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+                raise InputError(f"variable {self.name}: {key} = {value!r} must be a finite number")
+        if not self.lower < self.upper:
+            raise InputError(f"variable {self.name}: bounds [{self.lower}, {self.upper}] must satisfy lower < upper")
+        object.__setattr__(self, "lower", float(self.lower))
+        object.__setattr__(self, "upper", float(self.upper))
+
+    @property
+    def axis_label(self) -> str:
+        """``label (unit)`` for a plot axis."""
+        text = self.label or self.name
+        return f"{text} ({self.unit})" if self.unit else text
+
+
+def as_design_array(X: Any, dim: int, what: str = "designs") -> np.ndarray:
+    """Validate designs and return them as a float array of shape (n, dim).
+
+    Parameters
+    ----------
+    X : array_like
+        One design (dim,) or several (n, dim).
+    dim : int
+        Number of design variables.
+    what : str
+        Name used in the error message.
+
+    Raises
+    ------
+    InputError
+        Wrong shape or a non-finite value.
+    """
+    try:
+        arr = np.array(X, dtype=float, ndmin=2)
+    except (TypeError, ValueError):
+        raise InputError(f"{what} must be numbers, got {X!r:.80}") from None
+    if arr.ndim != 2 or arr.shape[1] != dim:
+        raise InputError(f"{what} must have {dim} values per design, got shape {np.shape(X)}")
+    if not np.all(np.isfinite(arr)):
+        raise InputError(f"{what} must be finite, got {arr[~np.all(np.isfinite(arr), axis=1)][0].tolist()}")
+    return arr
+
+
+class DesignProblem:
+    """Base class of every design problem (a mechanism study, a test function, a user's simulator).
+
+    Subclasses set the class attributes (or instance attributes in ``__init__``) and implement :meth:`evaluate`,
+    and :meth:`margins` when there are constraints.  Instances must be picklable (a class defined at the top
+    level of a module) to be evaluated in worker processes or on Dask.
+
+    Attributes
+    ----------
+    name : str
+        Name of the problem (reports, the store's fingerprint).
+    variables : tuple of Variable
+        The design variables, 2 to 4 of them for the sparse method.
+    constraints : tuple of str
+        Names of the columns of :meth:`margins`.
+    outputs : tuple of str
+        Names of the outputs :meth:`evaluate` must return (finite floats); it may return more keys.
+    objective : str
+        The output minimised.
+    fit : str
+        ``"square"`` (the model fits the objective squared, as T_RMS² for an RMS torque) or ``"value"``.
+    output_units : dict
+        Unit of each output, for reports and axis labels (``{"t_rms": "N·m"}``).
+    version : int
+        Bump it when :meth:`evaluate` changes in a way :meth:`settings` does not show, so that stored samples of
+        the old code are not reused.
+    surrogate_order : tuple of int or None
+        Order of the variables in the sparse model's coordinates (paper 002 plans the ventilator over
+        (|OA|, |BC|, |AB|)); None keeps the declared order.
+    fd_step : float
+        Finite-difference step of local searches on the simulator, as a fraction of each variable's range: above
+        the simulator's noise (a time-stepping engine: 1e-3), as small as the arithmetic allows for a smooth,
+        closed-form one (1e-5, the default).
+    """
+
+    name: ClassVar[str] | str = "problem"
+    variables: tuple[Variable, ...] = ()
+    constraints: tuple[str, ...] = ()
+    outputs: tuple[str, ...] = ()
+    objective: str = ""
+    fit: str = "value"
+    output_units: dict[str, str] = {}  # noqa: RUF012 - read-only class default
+    version: int = 1
+    surrogate_order: tuple[int, ...] | None = None
+    fd_step: float = 1e-5
+
+    # --- to implement -------------------------------------------------------------------------------------------
+
+    def evaluate(self, x: np.ndarray) -> dict[str, float]:
+        """Simulate one design.
+
+        Parameters
+        ----------
+        x : (d,) ndarray
+            The design, in the variables' units.
+
+        Returns
+        -------
+        dict
+            At least every name of :attr:`outputs`, as finite floats; further JSON-able keys are stored too.
+
+        Raises
+        ------
+        InfeasibleDesignError
+            When the design cannot be simulated at all (it does not assemble, it cannot move); recorded as
+            ``infeasible``.  Any other exception is recorded as a failure of that design.
+        """
+        raise NotImplementedError(f"{type(self).__name__} must implement evaluate(x)")
+
+    def margins(self, X: np.ndarray) -> np.ndarray:
+        """Constraint margins of designs, vectorised: >= 0 where satisfied.
+
+        Parameters
+        ----------
+        X : (n, d) ndarray
+            Designs.
+
+        Returns
+        -------
+        (n, len(constraints)) ndarray
+            One column per name of :attr:`constraints`, in the constraint's own unit (mm, deg...).
+        """
+        return np.zeros((np.shape(X)[0], 0))
+
+    def settings(self) -> dict[str, Any]:
+        """Every setting that changes an output: engine, tables, physical constants, feasibility rules.
+
+        Returns
+        -------
+        dict
+            JSON-like; hashed into :meth:`fingerprint`.  The default is empty (then bump :attr:`version` when the
+            evaluator changes).
+        """
+        return {}
+
+    # --- optional ------------------------------------------------------------------------------------------------
+
+    def sampleable(self, X: np.ndarray) -> np.ndarray:
+        """Designs that may be simulated to build the model (default: the feasible ones).
+
+        A mechanism can often be simulated a little beyond its design rules (a toggle margin, a box face that is a
+        choice and not physics); lines that run on there span the feasible region's whole extent, so the line
+        models do not extrapolate inside it.  Plain bounds of a user's simulator are not crossed by default.
+        """
+        return self.feasible(X)
+
+    def screen(self, X: np.ndarray) -> np.ndarray:
+        """A cheaper feasibility test for search grids of millions of points (default: :meth:`feasible`).
+
+        The design finally reported is always checked with :meth:`feasible`.
+        """
+        return self.feasible(X)
+
+    def describe(self, x: np.ndarray) -> str:
+        """One line naming a design with units, e.g. ``oa=53.000 mm, ab=65.000 mm``."""
+        return ", ".join(f"{v.name}={float(xi):.4g}{(' ' + v.unit) if v.unit else ''}"
+                         for v, xi in zip(self.variables, np.ravel(x), strict=True))
+
+    def figures(self, designs: Mapping[str, np.ndarray], out: Path) -> dict[str, Path]:
+        """Mechanism-specific figures of named designs (drawings, time series, animation); default none.
+
+        Parameters
+        ----------
+        designs : mapping of str to (d,) ndarray
+            ``{"original": x0, "optimum": x*, ...}``.
+        out : Path
+            Folder to write PNG/GIF files into.
+
+        Returns
+        -------
+        dict
+            Caption -> file written.
+        """
+        return {}
+
+    # --- provided ------------------------------------------------------------------------------------------------
+
+    @property
+    def dim(self) -> int:
+        """Number of design variables d."""
+        return len(self.variables)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """Variable names in order."""
+        return tuple(v.name for v in self.variables)
+
+    @property
+    def bounds(self) -> np.ndarray:
+        """(d, 2) array of the variables' lower and upper bounds."""
+        return np.array([[v.lower, v.upper] for v in self.variables], dtype=float)
+
+    def in_box(self, X: np.ndarray, extend: float = 0.0) -> np.ndarray:
+        """Designs (n, d) inside the bounds, widened by ``extend`` times the width on each side."""
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        b = self.bounds
+        w = b[:, 1] - b[:, 0]
+        return np.all((X >= b[:, 0] - extend * w) & (X <= b[:, 1] + extend * w), axis=1)
+
+    def constraint_margins(self, X: Any) -> np.ndarray:
+        """:meth:`margins` with its input and output checked: (n, len(constraints)), NaN read as violated."""
+        X = as_design_array(X, self.dim)
+        M = np.asarray(self.margins(X), dtype=float)
+        if M.ndim == 1 and len(self.constraints) == 1:
+            M = M[:, None]
+        if M.shape != (X.shape[0], len(self.constraints)):
+            raise InputError(f"{self.name}: margins returned shape {M.shape}, expected "
+                             f"({X.shape[0]}, {len(self.constraints)}) for constraints {list(self.constraints)}")
+        return np.where(np.isnan(M), -np.inf, M)
+
+    def feasible(self, X: Any) -> np.ndarray:
+        """Designs (n, d) inside the bounds and satisfying every constraint."""
+        X = as_design_array(X, self.dim)
+        ok = self.in_box(X)
+        if len(self.constraints) and ok.any():
+            ok[ok] = np.all(self.constraint_margins(X[ok]) >= 0.0, axis=1)
+        return ok
+
+    def output_label(self, name: str) -> str:
+        """``name (unit)`` of an output, for tables and axes."""
+        unit = dict(self.output_units).get(name, "")
+        return f"{name} ({unit})" if unit else name
+
+    def objective_value(self, outputs: Mapping[str, float]) -> float:
+        """The objective from an evaluation's outputs."""
+        return float(outputs[self.objective])
+
+    def fingerprint(self) -> str:
+        """Hash of the problem's identity and :meth:`settings` (the key of its rows in the sample store)."""
+        return fingerprint({
+            "problem": f"{type(self).__module__}.{type(self).__qualname__}",
+            "name": self.name,
+            "version": self.version,
+            "variables": [v.name for v in self.variables],
+            "outputs": list(self.outputs),
+            "settings": self.settings(),
+        })
+
+    def check(self) -> None:
+        """Raise a one-line :class:`InputError` if the declaration is inconsistent (called before any work)."""
+        where = f"problem {self.name!r}"
+        if not self.variables or not all(isinstance(v, Variable) for v in self.variables):
+            raise InputError(f"{where}: variables must be a non-empty tuple of mechopt.Variable")
+        if len(set(self.names)) != len(self.names):
+            raise InputError(f"{where}: variable names {list(self.names)} are not distinct")
+        if not self.outputs or self.objective not in self.outputs:
+            raise InputError(f"{where}: objective {self.objective!r} must be one of outputs {list(self.outputs)}")
+        if self.fit not in FITS:
+            raise InputError(f"{where}: fit = {self.fit!r}; expected one of {', '.join(FITS)}")
+        order = self.surrogate_order
+        if order is not None and sorted(order) != list(range(self.dim)):
+            raise InputError(f"{where}: surrogate_order {order!r} must be a permutation of 0..{self.dim - 1}")
+
+    def design_dict(self, x: Sequence[float]) -> dict[str, float]:
+        """``{name: value}`` of a design."""
+        return {v.name: float(xi) for v, xi in zip(self.variables, np.ravel(x), strict=True)}
+
+    def __repr__(self) -> str:
+        return f"<{type(self).__name__} {self.name!r}: {', '.join(self.names)} -> {self.objective}>"

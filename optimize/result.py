@@ -1,0 +1,44 @@
+"""The one result type of :func:`mechopt.minimize`, whatever the method (scipy's ``OptimizeResult`` convention)."""
+
+from __future__ import annotations
+
+from scipy.optimize import OptimizeResult as _ScipyResult
+
+__all__ = ["OptimizeResult"]
+
+
+class OptimizeResult(_ScipyResult):
+    """Result of :func:`mechopt.minimize`: a dict with attribute access, as scipy's.
+
+    Attributes
+    ----------
+    x : (d,) ndarray
+        The best feasible design simulated, in the variables' units.
+    fun : float
+        Its simulated objective.
+    outputs : dict
+        Every output of the evaluator at ``x``.
+    nfev : int
+        Simulator calls the method used (distinct designs; what the budget counts).
+    nnew, nreused, nfailed : int
+        Of the designs the run asked for: simulated now, found in the store, failed.
+    success : bool
+        A feasible design was simulated.
+    message : str
+        One line on how the method ended.
+    method : str
+        ``"sparse"`` or a baseline's name.
+    model : ObjectiveModel or None
+        The global sparse model (sparse method).
+    stages : list
+        The pipeline's stages (sparse method).
+    validation : Validation or None
+        Held-out lines against the model (sparse method, when asked for).
+    trust : dict
+        Whether the line model resolves the landscape, and where the answer came from (``verdict``: one
+        sentence; studies and ``"sparse-global"``; :func:`mechopt.optimize.sparse.trust.study_trust`).
+    sampling : dict
+        Counts and the executor used.
+    wall_time_s : float
+        Wall time of the call.
+    """

@@ -1,0 +1,205 @@
+"""Study definitions: a TOML file (plus its data files) that names a mechanism kind, its settings and its region.
+
+A study is loaded by name (a folder of this package holding ``study.toml``, e.g. ``ventilator``) or by the path of a
+TOML file.  The engine reads the sections every study has (``name``, ``description``, ``kind``, ``[variables]``,
+``[designs.*]``, ``[surrogate]``, ``[paper]``, ``[compare]``); the mechanism plug-in registered for ``kind`` reads
+the rest and returns the :class:`~mechopt.optimize.problem.DesignProblem`.  Every key is checked: a missing, misspelt
+or ill-typed key is a one-line :class:`~mechopt.errors.StudyError` naming it.
+"""
+
+from __future__ import annotations
+
+import functools
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from mechopt.errors import MechoptError, StudyError
+from mechopt.optimize.problem import DesignProblem
+from mechopt.studies.registry import mechanism_factory
+from mechopt.studies.study_file import PACKAGED_STUDIES, StudyFile
+
+__all__ = ["STUDIES_DIR", "Study", "available_studies", "load_study"]
+
+STUDIES_DIR = PACKAGED_STUDIES
+
+#: Sections the engine reads; a plug-in declares its own in :data:`PLUGIN_SECTIONS`-style checks of its own.
+ENGINE_SECTIONS = {"name", "description", "kind", "variables", "designs", "surrogate", "paper", "compare",
+                   "validation", "simulator"}
+
+
+@dataclass(frozen=True)
+class Study:
+    """A loaded study.
+
+    Attributes
+    ----------
+    name : str
+        Study name.
+    path : Path
+        The TOML file.
+    description : str
+        One line for reports.
+    kind : str
+        The mechanism plug-in (``"four-bar"``...).
+    problem : DesignProblem
+        The design problem built by the plug-in.
+    designs : dict
+        Reference designs by name: ``{variable: value, "paper_...": figure}``.
+    paper : dict
+        The paper's figures the report compares with (``[paper]``).
+    file : StudyFile
+        The parsed file, for the sections later stages read (``surrogate``, ``compare``...).
+    """
+
+    name: str
+    path: Path
+    description: str
+    kind: str
+    problem: DesignProblem
+    designs: dict[str, dict[str, float]] = field(default_factory=dict)
+    paper: dict[str, Any] = field(default_factory=dict)
+    file: StudyFile | None = None
+
+    def design(self, name: str) -> np.ndarray:
+        """Reference design ``name`` as an array in the problem's variable order."""
+        if name not in self.designs:
+            raise StudyError(f"study {self.name!r} has no design {name!r}; it has {sorted(self.designs)}")
+        return np.array([self.designs[name][v] for v in self.problem.names], dtype=float)
+
+    def reference_designs(self) -> dict[str, np.ndarray]:
+        """Every reference design, name -> array."""
+        return {name: self.design(name) for name in self.designs}
+
+    def section(self, name: str) -> dict[str, Any]:
+        """A raw TOML section (empty dict when absent)."""
+        value = self.file.config.get(name, {}) if self.file else {}
+        return value if isinstance(value, dict) else {}
+
+    @property
+    def config(self) -> dict[str, Any]:
+        """The whole parsed TOML."""
+        return self.file.config if self.file else {}
+
+
+def available_studies() -> list[str]:
+    """Names of the studies shipped with mechopt (and of the multimodal test functions, for ``mechopt compare``)."""
+    from mechopt.studies.test_functions import SUITE
+
+    names = [p.parent.name.replace("_", "-") for p in STUDIES_DIR.glob("*/study.toml")]
+    return sorted(names) + sorted(SUITE)
+
+
+def _suite_study(name: str) -> Study | None:
+    """A test function of the multimodal suite as a study (no file: its problem is a class)."""
+    from mechopt.studies import test_functions
+
+    cls = test_functions.SUITE.get(name)
+    if cls is None:
+        return None
+    doc = (cls.__doc__ or name).strip().splitlines()[0]
+    return Study(name=name, path=Path(test_functions.__file__), description=doc, kind="test-function",
+                 problem=cls())
+
+
+def _resolve(name_or_path: str | Path) -> Path:
+    candidate = Path(name_or_path)
+    if candidate.suffix == ".toml":
+        if not candidate.is_file():
+            raise StudyError(f"study file {candidate} not found")
+        return candidate.resolve()
+    shipped = STUDIES_DIR / str(name_or_path) / "study.toml"
+    if shipped.is_file():
+        return shipped
+    folders = {p.parent.name.replace("_", "-"): p for p in STUDIES_DIR.glob("*/study.toml")}
+    if str(name_or_path) in folders:
+        return folders[str(name_or_path)]
+    raise StudyError(
+        f"unknown study {str(name_or_path)!r}: expected one of {available_studies()} or the path of a .toml file"
+    )
+
+
+def load_study(name_or_path: str | Path, options: dict[str, Any] | None = None) -> Study:
+    """Load and check a study by name or TOML path.
+
+    Parameters
+    ----------
+    name_or_path : str or Path
+        A shipped study's name (``"ventilator"``) or a ``.toml`` path.
+    options : dict, optional
+        Overrides passed to the mechanism plug-in (``{"engine": "analytic"}``).
+
+    Returns
+    -------
+    Study
+
+    Raises
+    ------
+    StudyError
+        Unknown study, malformed TOML, or a missing / unknown / ill-typed key (the message names it).
+    """
+    suite = _suite_study(str(name_or_path))
+    if suite is not None:
+        return suite
+    path = _resolve(name_or_path)
+    items = tuple(sorted((k, v) for k, v in (options or {}).items() if v is not None))
+    return _load_cached(str(path), path.stat().st_mtime_ns, items)
+
+
+@functools.lru_cache(maxsize=16)
+def _load_cached(path_str: str, _mtime: int, options: tuple) -> Study:
+    path = Path(path_str)
+    try:
+        config = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise StudyError(f"malformed TOML in {path.name}: {exc}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise StudyError(f"cannot read study file {path}: {exc}") from None
+    name = config.get("name", path.parent.name)
+    if not isinstance(name, str) or not name:
+        raise StudyError(f"{path.name}: key name must be a non-empty string")
+    packaged = name if (STUDIES_DIR / name / "study.toml").is_file() else None
+    if packaged is None and (STUDIES_DIR / name.replace("-", "_") / "study.toml").is_file():
+        packaged = name.replace("-", "_")
+    file = StudyFile(path, config, packaged)
+    kind = config.get("kind")
+    if not isinstance(kind, str):
+        raise StudyError(f"{path.name}: missing key kind (the mechanism plug-in, e.g. kind = \"four-bar\")")
+    try:
+        problem = mechanism_factory(kind)(file, dict(options))
+        if "simulator" in config:
+            # A user's simulator (a command or a Python function) replaces only the plug-in's evaluator.
+            from mechopt.studies.kinds.simulator_section import with_simulator
+
+            problem = with_simulator(file, problem)
+        problem.check()
+    except StudyError:
+        raise
+    except MechoptError as exc:
+        raise StudyError(f"{path.name}: {exc}") from None
+    designs = _designs(file, problem)
+    paper = file.table("paper", required=False)
+    return Study(name=name, path=path, description=str(config.get("description", "")), kind=kind, problem=problem,
+                 designs=designs, paper=dict(paper), file=file)
+
+
+def _designs(file: StudyFile, problem: DesignProblem) -> dict[str, dict[str, float]]:
+    table = file.table("designs", required=False)
+    out = {}
+    for name, value in table.items():
+        if not isinstance(value, dict):
+            raise StudyError(f"{file.where}: key designs.{name} must be a table of the variables {list(problem.names)}")
+        entry = {}
+        for key in value:
+            if key not in problem.names and not key.startswith("paper_"):
+                raise StudyError(f"{file.where}: unknown key designs.{name}.{key}; expected the variables "
+                                 f"{list(problem.names)} or paper_* figures")
+            entry[key] = file.number(value, key, f"designs.{name}")
+        missing = [v for v in problem.names if v not in entry]
+        if missing:
+            raise StudyError(f"{file.where}: key designs.{name}.{missing[0]} missing")
+        out[name] = entry
+    return out

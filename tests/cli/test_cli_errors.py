@@ -1,0 +1,166 @@
+"""Every user mistake of the reliability issue gets one clear line on stderr and a non-zero exit, before any
+simulation, and loses nothing already computed.  Commands run as real subprocesses, as a user types them."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import signal
+import sqlite3
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+SMALL = ["--engine", "analytic", "--workers", "1", "--no-progress", "--lines-fit", "4", "--samples-per-line", "8",
+         "--search-points", "100000", "--budget", "40"]
+
+
+def mechopt(*args: str, cwd: Path | None = None, timeout: float = 300):
+    """Run ``mechopt ARGS`` in a subprocess, as a user types it."""
+    return subprocess.run([sys.executable, "-m", "mechopt.cli.main", *args], capture_output=True, text=True,
+                          cwd=cwd, env={**os.environ, "MPLBACKEND": "Agg"}, timeout=timeout)
+
+
+def one_line(proc, *expected: str) -> str:
+    err = proc.stderr.strip()
+    assert proc.returncode != 0, proc.stdout
+    assert "Traceback" not in err and len(err.splitlines()) == 1, err
+    for text in expected:
+        assert text in err, err
+    return err
+
+
+def test_out_naming_a_file(tmp_path):
+    f = tmp_path / "a_file"
+    f.write_text("x")
+    one_line(mechopt("study", "--out", str(f), *SMALL), "a_file", "expected a folder")
+    one_line(mechopt("feasible", "--out", str(f)), "expected a folder")
+
+
+def test_plot_with_an_unknown_suffix(tmp_path):
+    one_line(mechopt("simulate", "--oa", "53", "--ab", "65", "--bc", "282", "--plot", str(tmp_path / "x.xyz")),
+             "x.xyz", ".png")
+
+
+@pytest.mark.parametrize("value", ["-1", "nan", "0"])
+def test_bad_truth_grid(tmp_path, value):
+    one_line(mechopt("study", "--out", str(tmp_path), "--truth-grid", value, *SMALL), "--truth-grid")
+
+
+def test_bad_points_per_line_is_rejected_before_any_work(tmp_path):
+    t0 = time.perf_counter()
+    one_line(mechopt("study", "--out", str(tmp_path / "o"), "--points-per-line", "-1", *SMALL), "--points-per-line")
+    assert not (tmp_path / "o").exists()  # nothing was started
+    assert time.perf_counter() - t0 < 60
+
+
+def test_damaged_result_and_model_files(tmp_path):
+    (tmp_path / "result.json").write_text('{"optimum": {"des')
+    one_line(mechopt("feasible", "--out", str(tmp_path)), "result.json", "damaged")
+    (tmp_path / "result.json").unlink()
+    (tmp_path / "model.json").write_text('{"format": "mechopt.studies.ObjectiveModel", "vers')
+    one_line(mechopt("validate", "--out", str(tmp_path), *SMALL), "model.json", "--refit")
+
+
+def test_a_store_with_garbage_in_the_middle(tmp_path):
+    store = tmp_path / "s.sqlite"
+    con = sqlite3.connect(store)
+    con.execute("CREATE TABLE t (x TEXT)")
+    con.executemany("INSERT INTO t VALUES (?)", [("y" * 500,)] * 200)
+    con.commit()
+    con.close()
+    data = bytearray(store.read_bytes())
+    data[len(data) // 2 : len(data) // 2 + 4096] = os.urandom(4096)
+    store.write_bytes(bytes(data))
+    one_line(mechopt("study", "--out", str(tmp_path / "o"), "--store", str(store), *SMALL), str(store.name))
+
+
+def test_validation_lines_zero_means_no_validation_not_nan(tmp_path):
+    from mechopt.cli.main import main
+
+    assert main(["study", "--out", str(tmp_path), "--lines", "0", *SMALL]) == 0
+    result = json.loads((tmp_path / "result.json").read_text())
+    assert result["validation"] is None
+    assert "NaN" not in (tmp_path / "result.json").read_text()
+    assert "## Validation" not in (tmp_path / "report.md").read_text()
+
+
+@contextlib.contextmanager
+def read_only(*paths: Path):
+    """Make files and folders unwritable, even for root (``chattr +i``), for the duration of the block."""
+    root = os.geteuid() == 0
+    for path in paths:
+        if root:
+            subprocess.run(["chattr", "+i", str(path)], check=True)
+        else:
+            os.chmod(path, 0o555 if path.is_dir() else 0o444)
+    try:
+        yield
+    finally:
+        for path in paths:
+            if root:
+                subprocess.run(["chattr", "-i", str(path)], check=False)
+            else:
+                os.chmod(path, 0o755 if path.is_dir() else 0o644)
+
+
+def test_read_only_folders_get_one_line_and_a_healthy_read_only_store_is_not_called_unusable(tmp_path):
+    from mechopt.runs.sampling import sample_designs
+    from mechopt.runs.store import SampleStore
+    from mechopt.studies.catalogue import load_study
+
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    store = ro / "s.sqlite"
+    problem = load_study("ventilator", {"engine": "analytic"}).problem
+    with SampleStore(store) as db:  # a healthy store with a few samples
+        assert sample_designs([(53.0, 65.0, 282.0), (40.0, 80.0, 270.0)], problem, db, progress=False).n_ok == 2
+    for p in [p for p in ro.iterdir() if p != store]:  # -wal / -shm of the closed store, if any
+        p.unlink()
+    with read_only(store, ro):
+        one_line(mechopt("study", "--out", str(ro / "out"), *SMALL), "cannot create", "read-only")
+        one_line(mechopt("feasible", "--out", str(ro)), "read-only")
+        one_line(mechopt("simulate", "--oa", "53", "--ab", "65", "--bc", "282", "--plot", str(ro / "p.png")),
+                 "read-only")
+        # A healthy store the user may read but not write: said to be read-only, not "not a usable store".
+        err = one_line(mechopt("study", "--out", str(tmp_path / "again"), "--store", str(store), "--seed", "7",
+                               *SMALL))
+        assert "not a usable" not in err and "read-only" in err
+
+
+def _sigint_default() -> None:
+    # A test run started in the background (nohup, `cmd &`) inherits SIGINT ignored, and Python then installs no
+    # KeyboardInterrupt handler: give the child the terminal's default, as a user's shell would.
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+def test_ctrl_c_leaves_one_line_and_an_intact_store(tmp_path):
+    store = tmp_path / "s.sqlite"
+    proc = subprocess.Popen([sys.executable, "-m", "mechopt.cli.main", "study", "--out", str(tmp_path / "o"),
+                             "--store", str(store), "--engine", "pymunk", "--workers", "2", "--no-progress",
+                             "--lines-fit", "21", "--samples-per-line", "25"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env={**os.environ, "MPLBACKEND": "Agg"}, preexec_fn=_sigint_default)
+    # Interrupt once some designs are stored.
+    deadline = time.time() + 240
+    while time.time() < deadline:
+        time.sleep(1.0)
+        if store.exists():
+            try:
+                with sqlite3.connect(store) as con:
+                    if con.execute("SELECT COUNT(*) FROM samples").fetchone()[0] >= 5:
+                        break
+            except sqlite3.Error:
+                pass
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err
+    lines = [line for line in err.strip().splitlines() if line.strip()]
+    assert len(lines) == 1 and "interrupted" in lines[0] and "Traceback" not in err, err
+    with sqlite3.connect(store) as con:
+        assert con.execute("PRAGMA integrity_check").fetchone()[0] == "ok"
+        assert con.execute("SELECT COUNT(*) FROM samples").fetchone()[0] >= 5

@@ -1,0 +1,158 @@
+"""``mechopt.minimize`` on problems defined here, in the test file alone, with no edit of the package: a closed-form
+2-variable problem with one constraint through the store, a smooth 4-D function, the ventilator's refinement
+accounting, and the fingerprint that keeps different studies' samples apart."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import mechopt
+from mechopt.runs.sampling import sample_designs
+from mechopt.runs.store import SampleStore
+from mechopt.sim.fourbar.load import RockerLoad
+from mechopt.sim.fourbar.problem import FourBarProblem
+
+#: The ventilator's true optimum, T_RMS in N·m (brute force: see test_ground_truth.py).
+T_TRUE = 1.7582
+
+
+class Bracket(mechopt.DesignProblem):
+    """Mass-like objective pulled towards (1.3, 1.2) mm and kept inside a disc of radius 1.5 mm.
+
+    The constrained optimum is the disc's point towards (1.3, 1.2): x* = 1.5 (1.3, 1.2) / |(1.3, 1.2)|, with
+    f* = 1 + (|(1.3, 1.2)| − 1.5)².
+    """
+
+    name = "bracket"
+    variables = (mechopt.Variable("a", 0.0, 2.0, "mm"), mechopt.Variable("b", 0.0, 2.0, "mm"))
+    constraints = ("disc_mm2",)
+    outputs = ("f",)
+    objective = "f"
+
+    def margins(self, X):
+        return (1.5**2 - X[:, 0] ** 2 - X[:, 1] ** 2)[:, None]
+
+    def evaluate(self, x):
+        return {"f": 1.0 + (x[0] - 1.3) ** 2 + (x[1] - 1.2) ** 2}
+
+
+R = np.hypot(1.3, 1.2)
+X_STAR = 1.5 * np.array([1.3, 1.2]) / R
+F_STAR = 1.0 + (R - 1.5) ** 2
+
+
+def test_a_problem_defined_in_a_test_file_is_minimised_through_the_store(tmp_path):
+    store = tmp_path / "bracket.sqlite"
+    result = mechopt.minimize(Bracket(), budget=60, store=store, seed=1)
+    assert result.success and result.nfev <= 60
+    np.testing.assert_allclose(result.x, X_STAR, atol=2e-3)
+    assert result.fun == pytest.approx(F_STAR, rel=1e-4)
+    assert result.outputs["f"] == result.fun and result.nnew == result.nfev
+    # The same call again: every design comes from the store, none is simulated twice.
+    again = mechopt.minimize(Bracket(), budget=60, store=store, seed=1)
+    assert again.nnew == 0 and again.nreused == again.nfev
+    np.testing.assert_array_equal(again.x, result.x)
+
+
+class Smooth4(mechopt.DesignProblem):
+    """A smooth, non-separable 4-D bowl with its minimum inside the box (known in closed form)."""
+
+    name = "smooth4"
+    variables = tuple(mechopt.Variable(n, 0.0, 10.0) for n in ("w", "x", "y", "z"))
+    outputs = ("f",)
+    objective = "f"
+    CENTER = np.array([3.1, 6.4, 4.7, 2.2])
+
+    def evaluate(self, x):
+        d = np.asarray(x) - self.CENTER
+        return {"f": 2.0 + 0.05 * d @ d + 0.02 * d[0] * d[1] + 0.01 * (d[2] - d[3]) ** 2 + 0.001 * np.sum(d**4)}
+
+
+def test_the_pipeline_finds_the_minimum_of_a_smooth_4d_function():
+    result = mechopt.minimize(Smooth4(), budget=300, seed=0, options={"refine": False})
+    # The model alone (10 lines at Fekete nodes, no local search) is within 0.5 % of the minimum, 2.0.
+    assert result.fun <= 2.0 * 1.005
+    assert result.stages[0].plan.dim == 4 and result.nfev <= 300
+
+
+def test_refinement_improves_on_the_model_candidate_within_the_budget(ventilator):
+    problem = mechopt.load_study("ventilator", {"engine": "analytic"}).problem
+    # The small first plan of a small budget (3 lines of 4 samples) misses the optimum, which lies on the region's
+    # boundary: the model's steps and the local search on the simulator must take over, within the budget.
+    result = mechopt.minimize(problem, budget=40, seed=0, options={"search_points": 200_000})
+    global_stage, stepped, *refined = result.stages
+    assert stepped.name == "model steps" and stepped.n_samples > 0
+    # SLSQP may stop with budget left (a converged search): steps on the corrected model then use it.
+    assert [s.name for s in refined] in ([], ["local refinement"], ["corrected steps"],
+                                         ["local refinement", "corrected steps"])
+    assert result.nfev <= 40
+    assert sum(s.n_samples for s in result.stages) + 1 <= 40
+    # The model's candidate was simulated, not taken from the model.
+    assert np.isfinite(global_stage.simulated) and global_stage.simulated != global_stage.predicted
+    assert min(s.simulated for s in result.stages[1:]) < global_stage.simulated
+    assert result.fun == min(s.simulated for s in result.stages)
+    assert problem.feasible(result.x)[0]
+    assert result.fun < T_TRUE * 1.005
+
+
+@pytest.mark.parametrize("method", ["slsqp", "differential_evolution"])
+def test_baselines_run_through_the_same_entry_point(method):
+    result = mechopt.minimize(Bracket(), budget=80, method=method, seed=0)
+    assert result.success and result.nfev <= 80 and result.method == method
+    assert result.fun == pytest.approx(F_STAR, rel=2e-2)
+
+
+@pytest.mark.parametrize(("kwargs", "expected"), [
+    ({"budget": 2}, "budget = 2"),
+    ({"method": "magic"}, "method = 'magic'"),
+    ({"seed": -1}, "seed = -1"),
+    ({"workers": 0}, "workers = 0"),
+    ({"options": {"n_lines": "seven"}}, "n_lines = 'seven'"),
+    ({"options": {"lines": 7}}, "unknown option lines"),
+])
+def test_bad_arguments_are_one_line_errors_before_any_work(kwargs, expected):
+    with pytest.raises(mechopt.InputError) as info:
+        mechopt.minimize(Bracket(), **{"budget": 50, **kwargs})
+    assert expected in str(info.value) and "\n" not in str(info.value)
+
+
+def _negated(load: RockerLoad) -> RockerLoad:
+    return RockerLoad(load.breaks, -np.asarray(load.coefs))
+
+
+def test_studies_that_differ_only_in_the_load_or_the_toggle_margin_never_share_samples(ventilator, tmp_path):
+    base = mechopt.load_study("ventilator", {"engine": "analytic"}).problem
+    m = base.mechanism
+    # The same sum of |spline coefficients| (the old cache key), a different load.
+    other_load = FourBarProblem(type(m)(**{**m.__dict__, "load": _negated(m.load)}), base.box, "analytic",
+                                base.name)
+    other_margin = FourBarProblem(type(m)(**{**m.__dict__, "toggle_margin_deg": 16.0}), base.box, "analytic",
+                                  base.name)
+    assert np.sum(np.abs(other_load.mechanism.load.coefs)) == np.sum(np.abs(m.load.coefs))
+    prints = {base.fingerprint(), other_load.fingerprint(), other_margin.fingerprint()}
+    assert len(prints) == 3
+    designs = [(53.0, 65.0, 282.0), (40.0, 80.0, 270.0)]
+    with SampleStore(tmp_path / "s.sqlite") as store:
+        first = sample_designs(designs, base, store, progress=False)
+        assert first.n_computed == 2
+        for problem in (other_load, other_margin):
+            res = sample_designs(designs, problem, store, progress=False)
+            assert res.n_cached == 0 and res.n_computed == 2
+        # Same settings: reused.
+        assert sample_designs(designs, base, store, progress=False).n_cached == 2
+    # And the load really changes the answer.
+    assert base.evaluate(np.array(designs[0]))["t_rms"] != other_load.evaluate(np.array(designs[0]))["t_rms"]
+
+
+def test_trust_report_says_whether_the_model_resolves_the_landscape():
+    from mechopt.studies.test_functions import Hartmann3
+
+    # A smooth bowl cut by a disc: 7 lines resolve it, the model's claim and its leave-one-line-out error agree.
+    smooth = mechopt.minimize(Bracket(), budget=200, seed=1)
+    assert smooth.trust["resolved"] and smooth.trust["lolo_median"] < 0.05
+    assert smooth.trust["verdict"].startswith("the global model resolves the landscape")
+    # Hartmann-3 (four basins, the global one narrow): the same plan cannot resolve it, and says so.
+    rough = mechopt.minimize(Hartmann3(), budget=150, seed=0)
+    assert not rough.trust["resolved"] and rough.trust["lolo_median"] > 0.05
+    assert "does not resolve" in rough.trust["verdict"] and "sparse-global" in rough.trust["verdict"]
