@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from mechopt.errors import StudyError
-from mechopt.sim.flexible.problem import FlexibleSliderCrankProblem, problem_from_study
+from mechopt.sim.flexible.problem import FlexibleSliderCrankProblem
+from mechopt.studies.kinds.flexible_slider_crank import problem_from_study
 from mechopt.studies.study_file import PACKAGED_STUDIES, StudyFile
 
 STUDY = PACKAGED_STUDIES / "flexible_slider_crank" / "study.toml"
