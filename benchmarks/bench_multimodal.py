@@ -8,7 +8,12 @@ For every suite function (studies/test_functions.py) and budget, 10 seeds of
   line model alone achieves;
 * ``DE``: scipy's differential evolution through the baselines' budget-counted problem (every call counted, the
   best FEASIBLE design kept);
-* ``EGO`` (``--ego``): SMT's EGO, 3 seeds at the smallest budget only: it spends minutes per run (Kriging refits).
+* ``EGO`` (``--ego``): SMT's EGO, 3 seeds at the smallest budget only: it spends minutes per run (Kriging refits);
+* ``auto``: the default method of :func:`mechopt.minimize` (:mod:`mechopt.optimize.auto`).
+
+Every method simulates through the problem's ``evaluate`` (a failure — an exception or NaN, as in
+``failing_hartmann3`` — is a NaN for the model methods and a failed call for DE/EGO).  The line-model methods
+handle 2 to 4 variables: their cells of the 6-D and 8-D functions are left empty.
 
 Printed per cell: the median gap (f_best − f_min) as % of the function's range over the box, the number of seeds
 whose best design lies in a global minimum's basin (a local descent from it ends there), and the median number of
@@ -31,6 +36,8 @@ import numpy as np
 if __package__ in (None, ""):
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from mechopt.errors import InfeasibleDesignError  # noqa: E402
+from mechopt.optimize.auto import auto_search  # noqa: E402
 from mechopt.optimize.budget import CountedProblem  # noqa: E402
 from mechopt.optimize.sparse_global import global_search  # noqa: E402
 from mechopt.studies.test_functions import SUITE, TestFunction  # noqa: E402
@@ -41,10 +48,37 @@ MAX_BUDGET_2D = 150
 VENTILATOR_OPTIMUM = (1.7582, (30.000, 70.512, 254.488))
 
 
+def simulate(p: TestFunction):
+    """Batch evaluator through ``p.evaluate``: NaN where the simulation raises or returns NaN."""
+
+    def one(x: np.ndarray) -> float:
+        try:
+            return float(p.evaluate(np.asarray(x, dtype=float))["f"])
+        except Exception:  # a failed simulation of a failure-region function
+            return math.nan
+
+    return lambda X: np.array([one(x) for x in np.atleast_2d(X)])
+
+
+def scalar(p: TestFunction):
+    """One-design objective for CountedProblem: a failure raises InfeasibleDesignError (counted, NaN)."""
+    from mechopt.errors import InfeasibleDesignError
+
+    batch = simulate(p)
+
+    def f(x: np.ndarray) -> float:
+        value = float(batch(x[None, :])[0])
+        if not math.isfinite(value):
+            raise InfeasibleDesignError("failed simulation")
+        return value
+
+    return f
+
+
 def run_sparse(p: TestFunction, budget: int, seed: int, **options) -> tuple[float, np.ndarray, int]:
     margins = p.constraint_margins if p.constraints else None
-    r = global_search(p, p.bounds, p.feasible, p.sampleable, budget=budget, fit=p.fit, seed=seed, margins=margins,
-                      **options)
+    r = global_search(simulate(p), p.bounds, p.feasible, p.sampleable, budget=budget, fit=p.fit, seed=seed,
+                      margins=margins, **options)
     return r.fun, r.x, r.nfev
 
 
@@ -52,7 +86,7 @@ def run_de(p: TestFunction, budget: int, seed: int) -> tuple[float, np.ndarray, 
     from mechopt.optimize.baselines.differential_evolution import minimize_differential_evolution
 
     cons = (lambda x: p.constraint_margins(x[None, :])[0]) if p.constraints else None
-    prob = CountedProblem(lambda x: float(p(x[None, :])[0]), p.bounds, budget, cons)
+    prob = CountedProblem(scalar(p), p.bounds, budget, cons, failure_errors=(InfeasibleDesignError,))
     r = minimize_differential_evolution(prob, seed)
     return float(r.fun), np.asarray(r.x), int(r.nfev)
 
@@ -61,9 +95,14 @@ def run_ego(p: TestFunction, budget: int, seed: int) -> tuple[float, np.ndarray,
     from mechopt.optimize.baselines.smt_ego import minimize_smt_ego
 
     cons = (lambda x: p.constraint_margins(x[None, :])[0]) if p.constraints else None
-    prob = CountedProblem(lambda x: float(p(x[None, :])[0]), p.bounds, budget, cons)
+    prob = CountedProblem(scalar(p), p.bounds, budget, cons, failure_errors=(InfeasibleDesignError,))
     r = minimize_smt_ego(prob, seed)
     return float(r.fun), np.asarray(r.x), int(r.nfev)
+
+
+def run_auto(p: TestFunction, budget: int, seed: int) -> tuple[float, np.ndarray, int]:
+    r = auto_search(simulate(p), p.bounds, budget, seed, feasible=p.feasible)
+    return r.fun, r.x, r.nfev
 
 
 METHODS = {
@@ -71,7 +110,10 @@ METHODS = {
     "sparse-model": lambda p, b, s: run_sparse(p, b, s, global_share=0.45, steps=False),
     "DE": run_de,
     "EGO": run_ego,
+    "auto": run_auto,
 }
+#: The line-model methods, defined for 2 to 4 variables.
+LINE_METHODS = ("sparse", "sparse-model")
 
 
 def cell(p: TestFunction, method: str, budget: int, seeds: range) -> tuple[str, float]:
@@ -88,7 +130,7 @@ def cell(p: TestFunction, method: str, budget: int, seeds: range) -> tuple[str, 
 
 
 def suite_table(budgets: list[int], n_seeds: int, ego: bool) -> None:
-    methods = ["sparse", "sparse-model", "DE"] + (["EGO"] if ego else [])
+    methods = ["auto", "sparse", "sparse-model", "DE"] + (["EGO"] if ego else [])
     print(f"median gap (% of range) | seeds in the global basin | median evaluations; {n_seeds} seeds "
           f"(EGO: 3 seeds, smallest budget)")
     print(f"{'function':16s} {'d':>1s} {'budget':>6s} " + " ".join(f"{m:>26s}" for m in methods))
@@ -99,7 +141,7 @@ def suite_table(budgets: list[int], n_seeds: int, ego: bool) -> None:
                 continue
             row = [f"{name:16s} {p.dim:1d} {budget:6d}"]
             for m in methods:
-                if m == "EGO" and budget != min(budgets):
+                if (m == "EGO" and budget != min(budgets)) or (m in LINE_METHODS and p.dim > 4):
                     row.append(f"{'-':>26s}")
                     continue
                 seeds = range(3) if m == "EGO" else range(n_seeds)

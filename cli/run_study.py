@@ -17,20 +17,24 @@ from typing import Any
 
 import numpy as np
 
+from mechopt.cli.study_header import study_header
+from mechopt.cli.study_options import study_options
+from mechopt.cli.study_plan import RunPlan, duration_text, open_store_if_any, plan_run
 from mechopt.errors import InputError
+from mechopt.optimize.arguments import check_method
 from mechopt.optimize.ground_truth import GroundTruth, load_or_compute
+from mechopt.optimize.minimize import run_method
 from mechopt.optimize.result import OptimizeResult
 from mechopt.optimize.sparse.options import SparseOptions
-from mechopt.optimize.sparse.pipeline import run_pipeline
 from mechopt.optimize.sparse.sampler import Sampler
 from mechopt.optimize.sparse.space import ModelSpace
 from mechopt.optimize.sparse.trust import study_trust
 from mechopt.optimize.sparse.validate import Validation, validate
-from mechopt.runs.executors import make_executor
+from mechopt.runs.executors import default_workers, make_executor
 from mechopt.runs.store import SampleStore
 from mechopt.studies.catalogue import Study
 
-__all__ = ["StudyRun", "check_output_folder", "run_study", "study_options", "summary_lines"]
+__all__ = ["StudyRun", "check_output_folder", "plan_study", "run_study", "study_options", "summary_lines"]
 
 
 @dataclass
@@ -48,12 +52,7 @@ class StudyRun:
     store_path: Path
     sampling: dict[str, Any] = field(default_factory=dict)
     failures: list = field(default_factory=list)
-
-
-def study_options(study: Study, overrides: dict[str, Any] | None = None) -> SparseOptions:
-    """The sparse options of a study: its ``[surrogate]`` section, then the command line's overrides."""
-    values = {**study.section("surrogate"), **{k: v for k, v in (overrides or {}).items() if v is not None}}
-    return SparseOptions(values, where="surrogate.")
+    plan: RunPlan | None = None
 
 
 def check_output_folder(out: Path) -> Path:
@@ -85,7 +84,7 @@ def check_output_folder(out: Path) -> Path:
 def run_study(study: Study, out: Path, options: SparseOptions, workers: int | None = None,
               scheduler: str | None = None, store_path: Path | None = None, progress: bool = True,
               truth: bool = False, truth_step: float = 1.0, retry_failed: bool = False,
-              log: Callable[[str], None] = print) -> StudyRun:
+              log: Callable[[str], None] = print, method: str = "sparse") -> StudyRun:
     """Run the study end to end and write its outputs to ``out``.
 
     Parameters
@@ -95,7 +94,7 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
     out : Path
         Output folder (checked before any simulation).
     options : SparseOptions
-        Pipeline settings.
+        The budget, the seed and the sparse method's settings (held-out lines, too).
     workers, scheduler : optional
         Local processes, or a Dask scheduler address.
     store_path : Path, optional
@@ -110,63 +109,120 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
         Simulate again the designs whose earlier simulation failed.
     log : callable
         Where progress lines go.
+    method : str
+        ``"sparse"`` (default), ``"sparse-global"`` or a baseline's name (:func:`mechopt.optimize.arguments.
+        available_methods`); held-out validation needs the line model of ``"sparse"``.
     """
     from mechopt.report.study_report import write_outputs
 
+    problem = study.problem
+    check_method(method, problem.dim, study.name)
     out = check_output_folder(out)
     store_path = Path(store_path) if store_path else out / "samples.sqlite"
-    problem = study.problem
-    space = ModelSpace(problem)
     timings: dict[str, float] = {}
     t_all = time.perf_counter()
     with SampleStore(store_path) as store, make_executor(workers=workers, scheduler=scheduler) as executor:
         sampler = Sampler(problem, store, executor, progress, retry_failed)
-        log(f"study {study.name}: {problem!r}, store {store_path}, {sampler.executor_description}")
+        plan = plan_run(study, options, method, store, executor.workers, retry_failed)
+        for line in [*study_header(study), f"  store {store_path}, {sampler.executor_description}", *plan.text()]:
+            log(line)
         t0 = time.perf_counter()
-        pipeline = run_pipeline(space, options, sampler, log=log)
+        result = run_method(problem, method, options, sampler, log)
         timings["optimise_s"] = time.perf_counter() - t0
         n_opt = len(sampler.designs)
-        log(f"  {pipeline.message}; {pipeline.n_simulations} simulations ({pipeline.stages[0].n_samples} on the "
-            "lines of the global model)")
-        validation = None
-        if options.validation_lines > 0:
-            t0 = time.perf_counter()
-            validation = validate(pipeline.stages[0].model, space, sampler, options.validation_lines,
-                                  options.validation_points, options.seed, f_min=pipeline.fun)
-            timings["validation_s"] = time.perf_counter() - t0
-            log(f"  validation: {validation.n_points} held-out simulations on {len(validation.lines)} lines, RMSE "
-                f"{validation.rmse:.4g} ({validation.relative_text()}), max {validation.max_error:.4g}")
+        log(f"  {_optimised_line(result)}")
+        validation = _validate(result, problem, options, sampler, timings, log)
         n_val = len(sampler.designs) - n_opt
-        pipeline.stages[0].model.save(out / "model.json")
+        if result.model is not None:
+            result.model.save(out / "model.json")
         t0 = time.perf_counter()
-        refs = {**study.reference_designs(), "optimum": pipeline.x}
-        records = sampler.records(np.vstack(list(refs.values())), desc="reference designs")
-        references = {name: {"design": study.problem.design_dict(x), "status": r.status, "outputs": dict(r.outputs),
-                             "error": r.error, "feasible": bool(problem.feasible(x)[0])}
-                      for (name, x), r in zip(refs.items(), records, strict=True)}
+        references = _references(study, result.x, sampler)
         timings["references_s"] = time.perf_counter() - t0
         sampling = {**sampler.summary(), "optimisation": n_opt, "validation": n_val,
                     "references": len(sampler.designs) - n_opt - n_val}
         failures = [(np.array(d), e) for d, e in sampler.failures.values()]
-    ground = None
-    truth_file = out / f"ground_truth_{truth_step:g}.json"
-    if truth or truth_file.is_file():
-        t0 = time.perf_counter()
-        ground = load_or_compute(problem, truth_file, truth_step, compute=truth)
-        timings["ground_truth_s"] = time.perf_counter() - t0
-    trust = study_trust(pipeline.stages[0], pipeline.best, validation)
-    log(f"  trust: {trust['verdict']}")
-    result = OptimizeResult(x=pipeline.x, fun=pipeline.fun, nfev=n_opt, success=bool(np.isfinite(pipeline.fun)),
-                            message=pipeline.message, method="sparse", model=pipeline.stages[0].model,
-                            stages=pipeline.stages, validation=validation,
-                            outputs=references["optimum"]["outputs"], trust=trust)
+    ground = _ground_truth(problem, out, truth, truth_step, timings)
+    if result.method == "sparse":
+        result["trust"] = study_trust(result.stages[0], result.pipeline.best, validation)
+    if result.get("trust"):
+        log(f"  trust: {result.trust['verdict']}")
+    result.update(validation=validation, outputs=references["optimum"]["outputs"])
+    if result.method == "sparse":
+        result["nfev"] = n_opt  # the pipeline's designs, confirmation and refinement included
     timings["total_s"] = time.perf_counter() - t_all
     run = StudyRun(study, options, result, validation, references, ground, timings, out, store_path, sampling,
-                   failures)
+                   failures, plan)
     t0 = time.perf_counter()
     write_outputs(run)
     timings["report_s"] = time.perf_counter() - t0
     return run
+
+
+def plan_study(study: Study, options: SparseOptions, workers: int | None = None, scheduler: str | None = None,
+               store_path: Path | None = None, retry_failed: bool = False, method: str = "sparse") -> RunPlan:
+    """The plan of :func:`run_study` without running it: nothing is simulated and no file is written.
+
+    Parameters are those of :func:`run_study`; ``store_path`` is read when it exists (a resumed run costs only the
+    designs it lacks) and never created.
+    """
+    check_method(method, study.problem.dim, study.name)
+    if scheduler is not None:
+        with make_executor(workers=workers, scheduler=scheduler) as executor:  # only to count the cluster's workers
+            n_workers = executor.workers
+    else:
+        n_workers = workers or default_workers()
+    store = open_store_if_any(store_path) if store_path is not None else None
+    try:
+        return plan_run(study, options, method, store, n_workers, retry_failed)
+    finally:
+        if store is not None:
+            store.close()
+
+
+def _optimised_line(result: OptimizeResult) -> str:
+    if result.method == "sparse":
+        pipeline = result.pipeline
+        return (f"{pipeline.message}; {pipeline.n_simulations} simulations ({pipeline.stages[0].n_samples} on the "
+                "lines of the global model)")
+    return f"{result.method}: {result.message}; {result.nfev} simulations"
+
+
+def _validate(result: OptimizeResult, problem, options: SparseOptions, sampler: Sampler, timings: dict[str, float],
+              log: Callable[[str], None]) -> Validation | None:
+    """Held-out lines against the line model (``"sparse"`` only: the other methods have no model to check)."""
+    n_lines, per_line = options.validation_plan()
+    if n_lines == 0 or result.model is None:
+        return None
+    t0 = time.perf_counter()
+    validation = validate(result.model, ModelSpace(problem), sampler, n_lines, per_line, options.seed,
+                          f_min=result.fun)
+    timings["validation_s"] = time.perf_counter() - t0
+    unit = dict(problem.output_units).get(problem.objective, "")
+    log(f"  validation: {validation.n_points} held-out simulations on {len(validation.lines)} lines, on top of the "
+        f"budget; RMSE {validation.rmse:.4g}{(' ' + unit) if unit else ''} ({validation.relative_text(unit)}), "
+        f"largest error {validation.max_error:.4g}{(' ' + unit) if unit else ''}")
+    return validation
+
+
+def _references(study: Study, x_opt: np.ndarray, sampler: Sampler) -> dict[str, dict[str, Any]]:
+    """Every reference design of the study, and the optimum, with its outputs and feasibility."""
+    problem = study.problem
+    refs = {**study.reference_designs(), "optimum": np.asarray(x_opt, dtype=float)}
+    records = sampler.records(np.vstack(list(refs.values())), desc="reference designs")
+    return {name: {"design": problem.design_dict(x), "status": r.status, "outputs": dict(r.outputs),
+                   "error": r.error, "feasible": bool(problem.feasible(x)[0])}
+            for (name, x), r in zip(refs.items(), records, strict=True)}
+
+
+def _ground_truth(problem, out: Path, truth: bool, truth_step: float, timings: dict[str, float]) -> GroundTruth | None:
+    """The brute-force optimum when asked for, or when an earlier run left it cached in ``out``."""
+    truth_file = out / f"ground_truth_{truth_step:g}.json"
+    if not (truth or truth_file.is_file()):
+        return None
+    t0 = time.perf_counter()
+    ground = load_or_compute(problem, truth_file, truth_step, compute=truth)
+    timings["ground_truth_s"] = time.perf_counter() - t0
+    return ground
 
 
 def summary_lines(run: StudyRun) -> list[str]:
@@ -184,10 +240,22 @@ def summary_lines(run: StudyRun) -> list[str]:
         lines.append(f"ground truth (brute force, grid {run.truth.step:g} + polish): "
                      f"{problem.describe(np.array(run.truth.x))}, {obj} {run.truth.fun:.6g}; gap "
                      f"{100 * (run.result.fun / run.truth.fun - 1):+.2f} %")
-    s = run.sampling
-    lines.append(f"simulations: {s['optimisation']} to optimise ({run.result.stages[0].n_samples} on the lines of the "
-                 f"global model), {s['validation']} to validate, {s['references']} reference designs; "
-                 f"{s['new']} new, {s['reused']} reused from the store, {s['failed']} failed, "
-                 f"{s['waited_for_other_runs']} computed by another run; {s['executor']}; "
-                 f"total {run.timings['total_s']:.1f} s; outputs in {run.out}")
+    lines.append(_simulations_line(run))
     return lines
+
+
+def _simulations_line(run: StudyRun) -> str:
+    """Where the simulations went, against the budget: validation is on top of it, and says by how much."""
+    s, budget = run.sampling, int(run.options.budget)
+    stages = run.result.get("stages") or []
+    on_lines = f"; {stages[0].n_samples} on the lines of the global model" if stages else ""
+    val = (f"{s['validation']} to validate (held-out, on top of the budget: {s['validation'] / budget:.0%} of it)"
+           if s["validation"] else "no validation")
+    in_all = s["optimisation"] + s["validation"] + s["references"]
+    expected = run.plan.seconds if run.plan is not None else None
+    wall = f"wall time {run.timings['total_s']:.1f} s" + (
+        "" if expected is None else f" (the plan expected about {duration_text(expected)} of simulation)")
+    return (f"simulations: {s['optimisation']} to optimise (budget {budget}, method {run.result.method}{on_lines}), "
+            f"{val}, {s['references']} more for the reference designs; {in_all} designs in all: {s['new']} new, "
+            f"{s['reused']} reused from the store, {s['failed']} failed, {s['waited_for_other_runs']} computed by "
+            f"another run; {s['executor']}; {wall}; outputs in {run.out}")

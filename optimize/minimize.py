@@ -12,6 +12,14 @@ from typing import Any
 import numpy as np
 
 from mechopt.errors import InfeasibleDesignError, InputError
+from mechopt.optimize.arguments import (
+    AUTO_METHOD,
+    SPARSE_METHODS,
+    check_budget,
+    check_method,
+    check_seed,
+    check_workers,
+)
 from mechopt.optimize.problem import DesignProblem
 from mechopt.optimize.result import OptimizeResult
 from mechopt.optimize.sparse.options import SparseOptions
@@ -23,14 +31,14 @@ from mechopt.optimize.sparse.validate import validate
 from mechopt.runs.executors import make_executor
 from mechopt.runs.store import SampleStore
 
-__all__ = ["METHODS", "minimize"]
+__all__ = ["METHODS", "minimize", "run_method"]
 
 #: ``"sparse"``: the pipeline of paper 002 (global model, confirmation, local refinement) — for smooth landscapes;
 #: ``"sparse-global"``: the same lines and blend made global on multimodal ones (basins of the blend and of its
 #: leave-one-line-out uncertainty simulated, then steps on the blend corrected by every simulation;
 #: :mod:`mechopt.optimize.sparse_global`).  Every
 #: name of :data:`mechopt.optimize.baselines.BASELINES` is a method too.
-METHODS = ("sparse", "sparse-global")
+METHODS = SPARSE_METHODS
 
 
 def _baselines() -> dict[str, Callable[..., Any]]:
@@ -43,19 +51,13 @@ def _check_arguments(problem: Any, budget: Any, method: Any, seed: Any, workers:
     if not isinstance(problem, DesignProblem):
         raise InputError(f"problem must be a mechopt.DesignProblem, got {type(problem).__name__}")
     problem.check()
-    if isinstance(budget, bool) or not isinstance(budget, int | np.integer) or budget < 3:
-        raise InputError(f"budget = {budget!r}: expected a whole number of simulations >= 3")
-    if not callable(method) and method not in METHODS and method not in _baselines():
-        raise InputError(f"method = {method!r}; expected 'sparse', one of {', '.join(_baselines())} or a callable")
-    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
-        raise InputError(f"seed = {seed!r}: expected a whole number >= 0")
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
-        raise InputError(f"workers = {workers!r}: expected a whole number >= 1")
-    if method in METHODS and not 2 <= problem.dim <= 4:
-        raise InputError(f"the sparse method handles 2 to 4 design variables; {problem.name!r} has {problem.dim}")
+    check_budget(budget)
+    check_method(method, problem.dim, problem.name, budget)
+    check_seed(seed)
+    check_workers(workers)
 
 
-def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[..., Any] = "sparse", seed: int = 0,
+def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[..., Any] = AUTO_METHOD, seed: int = 0,
              workers: int | None = 1, store: str | Path | SampleStore | None = None,
              options: Mapping[str, Any] | SparseOptions | None = None, scheduler: Any = None,
              progress: bool = False, retry_failed: bool = False,
@@ -69,7 +71,9 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
     budget : int
         Most simulations the method may ask for (validation simulations of the sparse method come on top).
     method : str or callable
-        ``"sparse"`` (the line-sampled sparse model of paper 002, then a local search on the simulator),
+        ``"auto"`` (default: Gaussian-process steps on a plan chosen by dimension and budget, failed simulations
+        learned and avoided; needs a budget >= 2d + 2; :mod:`mechopt.optimize.auto`), ``"sparse"`` (the
+        line-sampled sparse model of paper 002, then a local search on the simulator),
         ``"sparse-global"`` (for multimodal objectives: the lines' blend, its basins, then steps on the blend
         corrected by every simulation; :mod:`mechopt.optimize.sparse_global`), a
         baseline's name (``"slsqp"``, ``"differential_evolution"``...) or a callable
@@ -123,14 +127,11 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
             db = stack.enter_context(SampleStore(store))
         executor = stack.enter_context(make_executor(workers=workers, scheduler=scheduler))
         sampler = Sampler(problem, db, executor, progress, retry_failed)
-        if method == "sparse":
-            result = _sparse(problem, opts, sampler, log)
-        elif method == "sparse-global":
-            result = _sparse_global(problem, int(budget), int(seed), sampler)
-        else:
-            fn = method if callable(method) else _baselines()[method]
-            result = _baseline(problem, fn, int(budget), int(seed), sampler,
-                               method if isinstance(method, str) else getattr(fn, "__name__", "custom"))
+        result = run_method(problem, method, opts, sampler, log)
+        if result.method == "sparse" and opts.validation_lines > 0:
+            result["validation"] = validate(result.model, ModelSpace(problem), sampler, opts.validation_lines,
+                                            opts.validation_points, opts.seed, f_min=result.fun)
+            result["trust"] = study_trust(result.stages[0], result.pipeline.best, result.validation)
         result["sampling"] = sampler.summary()
         result["nnew"], result["nreused"] = sampler.n_computed, sampler.n_cached
         result["nfailed"] = len(sampler.failures)
@@ -141,19 +142,49 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
     return result
 
 
+def run_method(problem: DesignProblem, method: str | Callable[..., Any], opts: SparseOptions, sampler: Sampler,
+               log: Callable[[str], None]) -> OptimizeResult:
+    """Run one method on ``problem`` through ``sampler`` (its store and executor), within ``opts.budget``.
+
+    The dispatch of :func:`minimize`, shared with ``mechopt study``; arguments are checked by the caller.
+
+    Parameters
+    ----------
+    problem : DesignProblem
+        The problem.
+    method : str or callable
+        A name of :func:`mechopt.optimize.arguments.available_methods` or ``f(counted_problem, seed)``.
+    opts : SparseOptions
+        The budget, the seed and the sparse method's settings.
+    sampler : Sampler
+        Where designs are simulated (and found again).
+    log : callable
+        Where progress lines go.
+
+    Returns
+    -------
+    OptimizeResult
+        Without ``validation`` (held-out lines are the caller's choice).
+    """
+    if method == AUTO_METHOD:
+        return _auto(problem, int(opts.budget), int(opts.seed), sampler)
+    if method == "sparse":
+        return _sparse(problem, opts, sampler, log)
+    if method == "sparse-global":
+        return _sparse_global(problem, int(opts.budget), int(opts.seed), sampler)
+    fn = method if callable(method) else _baselines()[method]
+    return _baseline(problem, fn, int(opts.budget), int(opts.seed), sampler,
+                     method if isinstance(method, str) else getattr(fn, "__name__", "custom"))
+
+
 def _sparse(problem: DesignProblem, opts: SparseOptions, sampler: Sampler, log: Callable[[str], None]):
     space = ModelSpace(problem)
     pipeline = run_pipeline(space, opts, sampler, log=log)
-    nfev = len(sampler.designs)
-    validation = None
-    if opts.validation_lines > 0:
-        validation = validate(pipeline.stages[0].model, space, sampler, opts.validation_lines,
-                              opts.validation_points, opts.seed, f_min=pipeline.fun)
     success = bool(np.isfinite(pipeline.fun) and space.feasible(pipeline.x)[0])
-    return OptimizeResult(x=pipeline.x, fun=pipeline.fun, nfev=nfev, success=success, message=pipeline.message,
-                          method="sparse", model=pipeline.stages[0].model, stages=pipeline.stages,
-                          pipeline=pipeline, validation=validation, options=opts,
-                          trust=study_trust(pipeline.stages[0], pipeline.best, validation))
+    return OptimizeResult(x=pipeline.x, fun=pipeline.fun, nfev=len(sampler.designs), success=success,
+                          message=pipeline.message, method="sparse", model=pipeline.stages[0].model,
+                          stages=pipeline.stages, pipeline=pipeline, validation=None, options=opts,
+                          trust=study_trust(pipeline.stages[0], pipeline.best, None))
 
 
 def _sparse_global(problem: DesignProblem, budget: int, seed: int, sampler: Sampler) -> OptimizeResult:
@@ -172,6 +203,22 @@ def _sparse_global(problem: DesignProblem, budget: int, seed: int, sampler: Samp
     return OptimizeResult(x=np.asarray(res.x, dtype=float), fun=float(res.fun), nfev=len(sampler.designs),
                           success=success, message=str(trust.get("verdict", "")), method="sparse-global",
                           model=None, models=res.models, stages=[], validation=None, trust=trust)
+
+
+def _auto(problem: DesignProblem, budget: int, seed: int, sampler: Sampler) -> OptimizeResult:
+    from mechopt.optimize.auto import auto_search
+
+    def evaluate(X: np.ndarray) -> np.ndarray:
+        return sampler(np.atleast_2d(X), desc=AUTO_METHOD)
+
+    def margins(X: np.ndarray) -> np.ndarray:
+        return problem.constraint_margins(np.atleast_2d(X))
+
+    res = auto_search(evaluate, problem.bounds, budget, seed, feasible=problem.feasible,
+                      margins=margins if problem.constraints else None)
+    success = bool(np.all(np.isfinite(res.x)) and problem.feasible(res.x)[0])
+    return OptimizeResult(x=res.x, fun=res.fun, nfev=len(sampler.designs), success=success, message=res.message,
+                          method=AUTO_METHOD, plan=res.plan.name, model=None, stages=[], validation=None)
 
 
 def _baseline(problem: DesignProblem, fn: Callable[..., Any], budget: int, seed: int, sampler: Sampler,

@@ -294,27 +294,13 @@ def _as_objective(fit: str, value: np.ndarray) -> np.ndarray:
     return np.sqrt(np.maximum(value, 0.0)) if fit == "square" else value
 
 
-def global_search(
-    evaluate: BatchEvaluator,
-    bounds: Any,
-    feasible: Predicate,
-    sampleable: Predicate | None = None,
-    budget: int = 300,
-    fit: str = "value",
-    seed: int = 0,
-    *,
-    margins: Callable[[np.ndarray], np.ndarray] | None = None,
-    global_share: float = 0.3,
-    samples_per_line: int = 5,
-    n_lines: int | None = None,
-    max_order: int = 4,
-    n_candidates: int | None = None,
-    kappa: float = 1.0,
-    basin_radius: float = 0.12,
-    exploit_share: float = 0.15,
-    cycle: tuple[float, ...] = DISTANCE_CYCLE,
-    steps: bool = True,
-) -> GlobalSearchResult:
+def global_search(evaluate: BatchEvaluator, bounds: Any, feasible: Predicate, sampleable: Predicate | None = None,
+                  budget: int = 300, fit: str = "value", seed: int = 0, *,
+                  margins: Callable[[np.ndarray], np.ndarray] | None = None, global_share: float = 0.3,
+                  samples_per_line: int = 5, n_lines: int | None = None, max_order: int = 4,
+                  n_candidates: int | None = None, kappa: float = 1.0, basin_radius: float = 0.12,
+                  exploit_share: float = 0.15, cycle: tuple[float, ...] = DISTANCE_CYCLE,
+                  steps: bool = True) -> GlobalSearchResult:
     """Global minimum of an expensive function from samples on lines, their blend, its basins and steps on the
     blend corrected by every simulation (see the module docstring).
 
@@ -374,6 +360,21 @@ def global_search(
     InputError
         Bad bounds, budget or option; no line plan fits the region within the budget.
     """
+    b = _checked_bounds(bounds, fit, budget, global_share, exploit_share, cycle)
+    if n_candidates is None:
+        n_candidates = int(np.clip(budget // 40, 1, 4))
+    run = _GlobalRun(evaluate, b, feasible, feasible if sampleable is None else sampleable, budget, fit)
+    glob = run.global_stage(global_share, samples_per_line, n_lines, max_order, seed, kappa, n_candidates,
+                            basin_radius)
+    best_before_steps = run.counted.best(run.feas_z)
+    if steps and run.counted.nfev and run.counted.remaining > 0:
+        run.corrected_steps(glob, exploit_share, seed, cycle, margins)
+    return run.result(best_before_steps)
+
+
+def _checked_bounds(bounds: Any, fit: str, budget: int, global_share: float, exploit_share: float,
+                    cycle: tuple[float, ...]) -> np.ndarray:
+    """The bounds as a (d, 2) float array, after checking the options of :func:`global_search` that need it."""
     b = np.asarray(bounds, dtype=float)
     if b.ndim != 2 or b.shape[1] != 2 or b.shape[0] not in (2, 3, 4) or not np.all(b[:, 1] > b[:, 0]):
         raise InputError(f"bounds must be a (d, 2) array with lower < upper and d in 2..4, got {b.tolist()}")
@@ -387,70 +388,97 @@ def global_search(
                          "(0, 1] and [0, 1)")
     if not cycle or any(not 0 <= c < 1 for c in cycle):
         raise InputError(f"cycle = {cycle}: expected distances in [0, 1) (fractions of the box)")
-    lower, width = b[:, 0], b[:, 1] - b[:, 0]
-    if n_candidates is None:
-        n_candidates = int(np.clip(budget // 40, 1, 4))
-    sampleable = feasible if sampleable is None else sampleable
+    return b
 
-    def in_x(pred: Predicate) -> Predicate:
+
+class _GlobalRun:
+    """One global search, in the unit cube of the bounds: the counted evaluator, the designs the global model
+    proposed with their simulated and predicted values, the stages and the trust report (see the module docstring).
+
+    Parameters
+    ----------
+    evaluate, feasible, sampleable, budget, fit :
+        As in :func:`global_search` (``sampleable`` already defaulted to ``feasible``).
+    bounds : (d, 2) ndarray
+        Checked box of the design variables (caller's units).
+    """
+
+    def __init__(self, evaluate: BatchEvaluator, bounds: np.ndarray, feasible: Predicate, sampleable: Predicate,
+                 budget: int, fit: str) -> None:
+        self.lower, self.width = bounds[:, 0], bounds[:, 1] - bounds[:, 0]
+        self.dim = bounds.shape[0]
+        self.budget, self.fit = budget, fit
+        self.feas_z, self.samp_z = self._in_unit_cube(feasible), self._in_unit_cube(sampleable)
+        self.counted = _Counted(evaluate, self.lower, self.width, int(budget))
+        self.models: dict[str, SparseExponentialModel] = {}
+        self.cand_z: list[np.ndarray] = []
+        self.cand_f: list[float] = []
+        self.cand_pred: list[float] = []
+        self.stages: list[dict[str, Any]] = []
+        self.trust: dict[str, Any] = {"lolo_median": math.nan, "lolo_max": math.nan, "claim_error": math.nan}
+
+    def _in_unit_cube(self, pred: Predicate) -> Predicate:
+        lower, width = self.lower, self.width
         return lambda Z: np.asarray(pred(lower + np.atleast_2d(Z) * width), dtype=bool).reshape(-1)
 
-    feas_z, samp_z = in_x(feasible), in_x(sampleable)
-    counted = _Counted(evaluate, lower, width, int(budget))
-    zero, one = np.zeros(dim), np.ones(dim)
-    models: dict[str, SparseExponentialModel] = {}
-    cand_z: list[np.ndarray] = []
-    cand_f: list[float] = []
-    cand_pred: list[float] = []
-    stages: list[dict[str, Any]] = []
+    def global_stage(self, global_share: float, samples_per_line: int, n_lines: int | None, max_order: int, seed: int,
+                     kappa: float, n_candidates: int, basin_radius: float) -> _Fitted | None:
+        """Steps 1 and 2: the global lines sampled and blended, then every distinct minimum of the blend and of its
+        optimistic bound simulated.  None when no line plan or fit exists."""
+        counted, dim = self.counted, self.dim
+        n_global = int(round(global_share * self.budget))
+        l_global = n_lines or max(_MIN_LINES[dim], n_global // samples_per_line)
+        n_global = max(n_global, _MIN_RUN * l_global)
+        zero, one = np.zeros(dim), np.ones(dim)
+        glob = _line_stage(counted, zero, one, self.feas_z, self.samp_z, l_global, samples_per_line, n_global,
+                           self.fit, max_order, seed, "global lines")
+        if glob is None:
+            self.stages.append({"name": "global", "lines": 0, "nfev": counted.nfev, "message": "no line plan fits"})
+            return None
+        self.models["global"] = glob.model
+        if glob.lolo is not None:
+            self.trust["lolo_median"], self.trust["lolo_max"] = glob.lolo.median, glob.lolo.max
+        by_model, by_bound = _basins(glob, zero, one, self.feas_z, kappa, n_candidates, n_candidates, basin_radius)
+        first = len(self.cand_z)
+        self.simulate_candidates([by_model, by_bound], glob.model, "global model")
+        self.stages.append({"name": "global", "lines": glob.model.l, "nfev": counted.nfev,
+                            "model_minima": len(by_model), "bound_minima": len(by_bound),
+                            "best": counted.best(self.feas_z)[1]})
+        if len(by_model):
+            self._record_claim(by_model, first)
+        return glob
 
-    def simulate_candidates(minima: list[Minima], model: SparseExponentialModel, source: str) -> None:
-        Z = np.vstack([m.x for m in minima]) if minima else np.zeros((0, dim))
+    def simulate_candidates(self, minima: list[Minima], model: SparseExponentialModel, source: str) -> None:
+        """Simulate the feasible, distinct designs among ``minima`` and keep them with the model's predictions."""
+        Z = np.vstack([m.x for m in minima]) if minima else np.zeros((0, self.dim))
         if Z.shape[0] == 0:
             return
-        Z = Z[feas_z(Z)]
+        Z = Z[self.feas_z(Z)]
         pts = thin(Z, model.predict(Z), 1e-6) if Z.shape[0] else None
         if pts is None or len(pts) == 0:
             return
-        f = counted(pts.x, source)
+        f = self.counted(pts.x, source)
         for z, fz, p in zip(pts.x, f, pts.value, strict=True):
-            cand_z.append(z)
-            cand_f.append(float(fz))
-            cand_pred.append(float(_as_objective(fit, p)))
+            self.cand_z.append(z)
+            self.cand_f.append(float(fz))
+            self.cand_pred.append(float(_as_objective(self.fit, p)))
 
-    # 1. Global lines.
-    n_global = int(round(global_share * budget))
-    l_global = n_lines or max(_MIN_LINES[dim], n_global // samples_per_line)
-    n_global = max(n_global, _MIN_RUN * l_global)
-    glob = _line_stage(counted, zero, one, feas_z, samp_z, l_global, samples_per_line, n_global, fit, max_order,
-                       seed, "global lines")
-    trust: dict[str, Any] = {"lolo_median": math.nan, "lolo_max": math.nan, "claim_error": math.nan}
-    if glob is not None:
-        models["global"] = glob.model
-        if glob.lolo is not None:
-            trust["lolo_median"], trust["lolo_max"] = glob.lolo.median, glob.lolo.max
-        # 2. Every distinct minimum of the blend and of its optimistic bound, simulated.
-        by_model, by_bound = _basins(glob, zero, one, feas_z, kappa, n_candidates, n_candidates, basin_radius)
-        first = len(cand_z)
-        simulate_candidates([by_model, by_bound], glob.model, "global model")
-        stages.append({"name": "global", "lines": glob.model.l, "nfev": counted.nfev,
-                       "model_minima": len(by_model), "bound_minima": len(by_bound),
-                       "best": counted.best(feas_z)[1]})
-        if len(by_model):
-            # The model's own claim: its best minimum, simulated first among the candidates.
-            j = next((i for i in range(first, len(cand_z))
-                      if np.allclose(cand_z[i], by_model.x[0])), None)
-            sampled_range = float(np.nanmax(counted.f) - np.nanmin(counted.f)) if counted.f else math.nan
-            if j is not None and sampled_range > 0 and math.isfinite(cand_f[j]):
-                trust["claim_error"] = abs(cand_pred[j] - cand_f[j]) / sampled_range
-    else:
-        stages.append({"name": "global", "lines": 0, "nfev": counted.nfev, "message": "no line plan fits"})
-    best_before_steps = counted.best(feas_z)
+    def _record_claim(self, by_model: Minima, first: int) -> None:
+        """How far the model's own claim (its best minimum, simulated first among the candidates from ``first``)
+        was from its simulation, relative to the range of the values sampled."""
+        j = next((i for i in range(first, len(self.cand_z))
+                  if np.allclose(self.cand_z[i], by_model.x[0])), None)
+        f = self.counted.f
+        sampled_range = float(np.nanmax(f) - np.nanmin(f)) if f else math.nan
+        if j is not None and sampled_range > 0 and math.isfinite(self.cand_f[j]):
+            self.trust["claim_error"] = abs(self.cand_pred[j] - self.cand_f[j]) / sampled_range
 
-    # 3. Steps on the blend corrected by every simulation: first cycling through distances from the simulated
-    #    designs (unseen regions, then closer), then at the corrected model's own minimum.
-    if steps and counted.nfev and counted.remaining > 0:
-        square = fit == "square"
+    def corrected_steps(self, glob: _Fitted | None, exploit_share: float, seed: int, cycle: tuple[float, ...],
+                        margins: Callable[[np.ndarray], np.ndarray] | None) -> None:
+        """Step 3: steps on the blend corrected by every simulation, first cycling through distances from the
+        simulated designs (unseen regions, then closer), then at the corrected model's own minimum."""
+        counted, lower, width = self.counted, self.lower, self.width
+        square = self.fit == "square"
 
         def step_value(z: np.ndarray) -> float:
             value = float(counted(z[None, :], "corrected model")[0])
@@ -463,38 +491,41 @@ def global_search(
             lambda Z: np.asarray(margins(counted.x(Z)), dtype=float).reshape(len(np.atleast_2d(Z)), -1))
         trend = None if glob is None else glob.model.predict
         f_all = np.array(counted.f)
-        n_exploit = min(counted.remaining, int(round(exploit_share * budget)))
-        Z, q = explore(step_value, np.array(counted.Z), f_all * f_all if square else f_all, trend, feas_z,
+        n_exploit = min(counted.remaining, int(round(exploit_share * self.budget)))
+        Z, q = explore(step_value, np.array(counted.Z), f_all * f_all if square else f_all, trend, self.feas_z,
                        counted.remaining - n_exploit, seed, cycle)
-        stages.append({"name": "corrected model, exploring", "nfev": counted.nfev, "best": counted.best(feas_z)[1]})
-        explore(step_value, Z, q, trend, feas_z, counted.remaining, seed + 1, (0.0,), margins=margins_z)
-        stages.append({"name": "corrected model, exploiting", "nfev": counted.nfev,
-                       "best": counted.best(feas_z)[1]})
+        self.stages.append({"name": "corrected model, exploring", "nfev": counted.nfev,
+                            "best": counted.best(self.feas_z)[1]})
+        explore(step_value, Z, q, trend, self.feas_z, counted.remaining, seed + 1, (0.0,), margins=margins_z)
+        self.stages.append({"name": "corrected model, exploiting", "nfev": counted.nfev,
+                            "best": counted.best(self.feas_z)[1]})
 
-    z_best, f_best, source = counted.best(feas_z)
-    sampled_best = min((fv for fv, s in zip(counted.f, counted.source, strict=True)
-                        if s.endswith("lines") and math.isfinite(fv)), default=math.inf)
-    model_best = min((fv for fv in cand_f if math.isfinite(fv)), default=math.inf)
-    trust["model_won"] = bool(model_best < sampled_best)
-    trust["best_before_steps"] = best_before_steps[1]
-    trust["source"] = source
-    trust["verdict"] = _verdict(trust, source)
-    return GlobalSearchResult(
-        x=lower + z_best * width if np.all(np.isfinite(z_best)) else z_best,
-        fun=f_best,
-        nfev=counted.nfev,
-        models=models,
-        candidates=lower + np.array(cand_z).reshape(-1, dim) * width,
-        candidate_values=np.array(cand_f),
-        candidate_predictions=np.array(cand_pred),
-        source=source,
-        trust=trust,
-        history_x=lower + np.array(counted.Z).reshape(-1, dim) * width,
-        history_f=np.array(counted.f),
-        stages=stages,
-    )
-
-
+    def result(self, best_before_steps: tuple[np.ndarray, float, str]) -> GlobalSearchResult:
+        """Step 4: the best simulated design, with the trust report completed (caller's units)."""
+        counted, lower, width, dim = self.counted, self.lower, self.width, self.dim
+        z_best, f_best, source = counted.best(self.feas_z)
+        sampled_best = min((fv for fv, s in zip(counted.f, counted.source, strict=True)
+                            if s.endswith("lines") and math.isfinite(fv)), default=math.inf)
+        model_best = min((fv for fv in self.cand_f if math.isfinite(fv)), default=math.inf)
+        trust = self.trust
+        trust["model_won"] = bool(model_best < sampled_best)
+        trust["best_before_steps"] = best_before_steps[1]
+        trust["source"] = source
+        trust["verdict"] = _verdict(trust, source)
+        return GlobalSearchResult(
+            x=lower + z_best * width if np.all(np.isfinite(z_best)) else z_best,
+            fun=f_best,
+            nfev=counted.nfev,
+            models=self.models,
+            candidates=lower + np.array(self.cand_z).reshape(-1, dim) * width,
+            candidate_values=np.array(self.cand_f),
+            candidate_predictions=np.array(self.cand_pred),
+            source=source,
+            trust=trust,
+            history_x=lower + np.array(counted.Z).reshape(-1, dim) * width,
+            history_f=np.array(counted.f),
+            stages=self.stages,
+        )
 
 
 def _verdict(trust: dict[str, Any], source: str) -> str:

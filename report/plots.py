@@ -18,19 +18,42 @@ from mechopt.sim.figure_file import figure_path, save_figure  # noqa: E402
 __all__ = ["plot_feasible_3d", "plot_feasible_slices", "plot_validation"]
 
 
+def _slice_tolerance(problem: DesignProblem) -> float:
+    """Two values of the first variable closer than this are one slice (a millionth of its range)."""
+    lo, hi = problem.bounds[0]
+    return 1e-6 * float(hi - lo)
+
+
 def _slice_values(problem: DesignProblem, marks: Mapping[str, np.ndarray], n_slices: int) -> list[float]:
     lo, hi = problem.bounds[0]
-    values = {float(lo), float(hi), float(0.5 * (lo + hi))}
-    values |= {float(m[0]) for m in marks.values() if lo <= m[0] <= hi}
-    values = sorted(values)
-    # Keep the box's ends and the marks' own slices (a mark is drawn only on the slice of its own value).
-    keep = [v for v in values if any(abs(v - float(m[0])) < 1e-9 for m in marks.values())]
-    for v in values:
-        if len(keep) >= n_slices:
-            break
-        if v not in keep:
-            keep.append(v)
-    return sorted(keep)
+    tol = _slice_tolerance(problem)
+    # A mark's own value first: an optimum on a bound (|OA| = 30 mm, computed as 30.0000000003) is that bound's
+    # slice, not a second one beside it.
+    values: list[float] = []
+    for v in [*(float(m[0]) for m in marks.values() if lo - tol <= m[0] <= hi + tol),
+              float(lo), float(hi), float(0.5 * (lo + hi))]:
+        if all(abs(v - w) > tol for w in values):
+            values.append(min(max(v, float(lo)), float(hi)))
+    n_marked = sum(1 for v in values if any(abs(v - float(m[0])) <= tol for m in marks.values()))
+    return sorted(values[:max(n_slices, n_marked)])
+
+
+def _draw_marks(ax, problem: DesignProblem, marks: Mapping[str, np.ndarray], value: float | None, ix: int,
+                iy: int) -> None:
+    """The marked designs of one slice (those whose first variable is the slice's ``value``), labelled."""
+    b = problem.bounds
+    for j, (name, m) in enumerate(marks.items()):
+        if value is not None and abs(float(m[0]) - value) > _slice_tolerance(problem):
+            continue
+        marker = "*" if "optimum" in name else "o"
+        ax.plot(m[ix], m[iy], marker, color="k", ms=12 if marker == "*" else 7, zorder=5)
+        # Labels alternate above and below their marker, so that close designs do not overwrite each other;
+        # near the bottom or top edge (an optimum on a bound) the label goes inside the axes.
+        dy = 8 if j % 2 == 0 else -13
+        height = (m[iy] - b[iy, 0]) / (b[iy, 1] - b[iy, 0])
+        dy = 8 if height < 0.1 else (-13 if height > 0.9 else dy)
+        ax.annotate(name, (m[ix], m[iy]), textcoords="offset points", xytext=(7, dy),
+                    fontsize=8, bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8})
 
 
 def plot_feasible_slices(problem: DesignProblem, path: str | Path, marks: Mapping[str, np.ndarray] | None = None,
@@ -90,14 +113,7 @@ def plot_feasible_slices(problem: DesignProblem, path: str | Path, marks: Mappin
                     color = colors[k % len(colors)]
                     ax.contour(GX, GY, values, levels=[0.0], colors=[color], linewidths=1.6)
                     handles[name] = plt.Line2D([], [], color=color, lw=1.6, label=f"{name} = 0")
-        for j, (name, m) in enumerate(marks.items()):
-            if value is not None and abs(float(m[0]) - value) > 1e-9:
-                continue
-            marker = "*" if "optimum" in name else "o"
-            ax.plot(m[ix], m[iy], marker, color="k", ms=12 if marker == "*" else 7, zorder=5)
-            # Labels alternate above and below their marker, so that close designs do not overwrite each other.
-            ax.annotate(name, (m[ix], m[iy]), textcoords="offset points", xytext=(7, 8 if j % 2 == 0 else -13),
-                        fontsize=8, bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8})
+        _draw_marks(ax, problem, marks, value, ix, iy)
         v = problem.variables
         ax.set_xlabel(v[ix].axis_label)
         ax.set_ylabel(v[iy].axis_label)
@@ -154,7 +170,7 @@ def plot_feasible_3d(problem: DesignProblem, path: str | Path, lines: list[np.nd
 
 
 def plot_validation(lines: list[dict], path: str | Path, fit_lines: list[tuple[np.ndarray, np.ndarray]] | None = None,
-                    model=None, label: str = "objective") -> Path:
+                    model=None, label: str = "objective", unit: str = "") -> Path:
     """The model against simulations along its fitting lines and held-out lines (paper Fig. 16), with the error.
 
     Parameters
@@ -169,6 +185,8 @@ def plot_validation(lines: list[dict], path: str | Path, fit_lines: list[tuple[n
         To draw its curve along the fitting lines.
     label : str
         The objective with its unit, for the axis.
+    unit : str
+        The objective's unit, for the error axis.
     """
     path = figure_path(path)
     fig, (ax, ax_err) = plt.subplots(2, 1, figsize=(11, 6.4), sharex=True, gridspec_kw={"height_ratios": [2.2, 1]})
@@ -194,7 +212,7 @@ def plot_validation(lines: list[dict], path: str | Path, fit_lines: list[tuple[n
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
     ax_err.axhline(0, color="0.5", lw=0.8)
-    ax_err.set_ylabel("model − simulation")
+    ax_err.set_ylabel(f"model − simulation ({unit})" if unit else "model − simulation")
     ax_err.set_xlabel("sample along the lines, one line after the other")
     ax_err.grid(alpha=0.3)
     fig.tight_layout()

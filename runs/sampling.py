@@ -12,7 +12,9 @@ evaluations and never evaluates a stored design again.
 Runs sharing a store share the work.  A run claims a few designs at a time (as many as its executor has free slots)
 before evaluating them, with a lease that a heartbeat thread renews every ``lease_s / 3``; designs validly claimed by
 another run are not evaluated but waited for, and taken over when their claim expires (their run died) or is
-released (it was interrupted).  Claims are released when the call ends, however it ends.
+released (it was interrupted).  Claims are released when the call ends, however it ends.  That loop lives in
+:mod:`~mechopt.runs.cooperative_evaluation`; this module prepares the request, evaluates one design in a worker
+(:func:`evaluate_one`) and sums up the outcome.
 """
 
 from __future__ import annotations
@@ -20,29 +22,23 @@ from __future__ import annotations
 import functools
 import json
 import math
-import threading
 import time
-from collections import deque
-from collections.abc import Iterable, Iterator, Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from tqdm.auto import tqdm
 
-from mechopt.errors import InfeasibleDesignError, InputError, MechoptError
+from mechopt.errors import InfeasibleDesignError, InputError
 from mechopt.optimize.problem import DesignProblem
-from mechopt.runs.executors import SampleExecutor, make_executor
-from mechopt.runs.store import SampleRecord, SampleStore, as_design, design_key, new_owner, utc_timestamp
+from mechopt.runs.cooperative_evaluation import CooperativeEvaluation, is_final
+from mechopt.runs.executors import SampleExecutor
+from mechopt.runs.store import SampleRecord, SampleStore, as_design, design_key, utc_timestamp
 
 __all__ = ["SamplingResult", "evaluate_one", "sample_designs"]
 
 # Long enough for any useful message, short enough for a table cell or a log line.
 _MAX_ERROR_CHARS = 500
-
-# Polling of designs another run is evaluating: first check soon (short evaluations), then back off.
-_POLL_FIRST_S = 0.02
-_POLL_MAX_S = 0.5
 
 
 @dataclass(frozen=True)
@@ -206,30 +202,35 @@ def evaluate_one(problem: DesignProblem, fingerprint: str, design: tuple[float, 
     return SampleRecord(**base, status="ok", outputs=outputs, wall_time_s=wall)
 
 
-class _Heartbeat:
-    """Renews a run's claims every ``lease_s / 3`` from a thread with its own connection, while evaluations run."""
+@dataclass(frozen=True)
+class _Request:
+    """The designs of one call: validated, keyed and deduplicated, with the call's fingerprint and retry cut-off."""
 
-    def __init__(self, store: SampleStore, owner: str, lease_s: float) -> None:
-        self._args = (store.path, store.timeout, owner, lease_s)
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._run, name="mechopt-claims-heartbeat", daemon=True)
-        self._thread.start()
+    designs: list[tuple[float, ...]]
+    keys: list[str]
+    unique: dict[str, tuple[float, ...]]
+    fingerprint: str
+    redo_failed_before: str | None
 
-    def _run(self) -> None:
-        path, timeout, owner, lease_s = self._args
-        try:
-            with SampleStore(path, timeout=timeout) as store:
-                while not self._stop.wait(lease_s / 3.0):
-                    try:
-                        store.renew_claims(owner, lease_s)
-                    except MechoptError:
-                        pass  # the next beat tries again; a lapse can only make another run duplicate work
-        except MechoptError:
-            pass
 
-    def stop(self) -> None:
-        self._stop.set()
-        self._thread.join()
+def _request(designs: Iterable[Sequence[float]], problem: DesignProblem, fingerprint: str | None, retry_failed: bool,
+             lease_s: float) -> _Request:
+    """Check the arguments of :func:`sample_designs` and key its designs (InputError for an unusable one)."""
+    if retry_failed:
+        # Timestamps have millisecond resolution: a failure stored in the same millisecond as this call's start
+        # would count as stored since (final), not before (to redo).  One tick later, everything before is earlier.
+        time.sleep(0.0011)
+    started_at = utc_timestamp()
+    if isinstance(lease_s, bool) or not isinstance(lease_s, int | float) or not lease_s > 0:
+        raise InputError(f"lease_s must be a positive number of seconds, got {lease_s!r}")
+    fp = problem.fingerprint() if fingerprint is None else fingerprint
+    dim = len(problem.variables) if getattr(problem, "variables", None) else None
+    requested = [as_design(d, dim) for d in designs]
+    keys = [design_key(d) for d in requested]
+    unique: dict[str, tuple[float, ...]] = {}
+    for k, d in zip(keys, requested, strict=True):
+        unique.setdefault(k, d)
+    return _Request(requested, keys, unique, fp, started_at if retry_failed else None)
 
 
 def sample_designs(
@@ -295,154 +296,30 @@ def sample_designs(
     stored result is kept), never lose one.
     """
     start = time.perf_counter()
-    if retry_failed:
-        # Timestamps have millisecond resolution: a failure stored in the same millisecond as this call's start
-        # would count as stored since (final), not before (to redo).  One tick later, everything before is earlier.
-        time.sleep(0.0011)
-    started_at = utc_timestamp()
-    if isinstance(lease_s, bool) or not isinstance(lease_s, int | float) or not lease_s > 0:
-        raise InputError(f"lease_s must be a positive number of seconds, got {lease_s!r}")
-    fp = problem.fingerprint() if fingerprint is None else fingerprint
-    dim = len(problem.variables) if getattr(problem, "variables", None) else None
-    requested = [as_design(d, dim) for d in designs]
-    keys = [design_key(d) for d in requested]
-    unique: dict[str, tuple[float, ...]] = {}
-    for k, d in zip(keys, requested, strict=True):
-        unique.setdefault(k, d)
-
-    def settled(record: SampleRecord) -> bool:
-        # With retry_failed, a failure stored before this call is still to be redone; one stored since is final.
-        return not (retry_failed and record.status == "failed" and record.timestamp < started_at)
-
-    found = {k: r for k, r in store.get_keys(unique, fp).items() if settled(r)}
-    n_cached = len(found)
-    pending = {k: d for k, d in unique.items() if k not in found}  # neither stored nor given up
-    counts = {"computed": 0, "waited": 0, "failed": 0, "infeasible": 0}
-    compute_time = 0.0
-    description = ""
-
+    request = _request(designs, problem, fingerprint, retry_failed, lease_s)
+    fp, redo = request.fingerprint, request.redo_failed_before
+    found = {k: r for k, r in store.get_keys(request.unique, fp).items() if is_final(r, redo)}
+    pending = {k: d for k, d in request.unique.items() if k not in found}  # neither stored nor given up
+    work = CooperativeEvaluation(store, fp, found, pending, n_cached=len(found), redo_failed_before=redo,
+                                 lease_s=lease_s)
     if pending:
-        owner = new_owner()
-        task = functools.partial(evaluate_one, problem, fp)
-        redo = started_at if retry_failed else None
-        ex: SampleExecutor | None = executor
-        heartbeat: _Heartbeat | None = None
-        state = {"claimed": False}
-        bar = tqdm(total=len(pending), desc=desc, unit="design", disable=None if progress else True,
-                   dynamic_ncols=True)
+        work.run(functools.partial(evaluate_one, problem, fp), executor, progress=progress, desc=desc)
+    return _sampling_result(request, work, start)
 
-        def settle(record: SampleRecord, waited: bool) -> None:
-            found[record.key] = record
-            pending.pop(record.key, None)
-            counts["waited" if waited else "computed"] += 1
-            if not record.ok:
-                counts[record.status] += 1
-            shown = {k: v for k, v in counts.items() if v and k != "computed"}
-            bar.set_postfix(cached=n_cached, **shown, refresh=False)
-            bar.update(1)
 
-        order = list(pending)
-        cursor = 0  # order[:cursor] are all settled or submitted
-
-        def claim(submitted: set[str], limit: int) -> list[str]:
-            nonlocal cursor
-            state["claimed"] = True
-            while cursor < len(order) and (order[cursor] not in pending or order[cursor] in submitted):
-                cursor += 1
-            # Lazy: without contention claim() reads only the first few candidates.
-            candidates = (
-                order[i] for i in range(cursor, len(order)) if order[i] in pending and order[i] not in submitted
-            )
-            return store.claim(fp, candidates, owner, lease_s, limit=limit, redo_failed_before=redo)
-
-        def feed(first: list[str], submitted: set[str], limit: int) -> Iterator[tuple[float, ...]]:
-            # Pulled by the executor one design per free slot: claim the next few only when the last are submitted,
-            # so that at most about max_in_flight designs are claimed but not yet stored.
-            queue = deque(first)
-            while queue:
-                key = queue.popleft()
-                submitted.add(key)
-                yield pending[key]
-                if not queue:
-                    queue.extend(claim(submitted, limit))
-
-        bar.set_postfix(cached=n_cached, refresh=False)
-        try:
-            poll = _POLL_FIRST_S
-            while pending:
-                # Results of other runs (and of runs that finished meanwhile).
-                for record in store.get_keys(pending, fp).values():
-                    if settled(record):
-                        settle(record, waited=True)
-                if not pending:
-                    break
-                if ex is None:
-                    ex = make_executor()
-                limit = max(1, ex.max_in_flight)
-                submitted: set[str] = set()
-                first = claim(submitted, limit)
-                if not first:
-                    # Everything left is being evaluated by other runs: wait for it, or for a claim to lapse.
-                    time.sleep(poll)
-                    poll = min(1.5 * poll, _POLL_MAX_S, lease_s / 4.0)
-                    continue
-                poll = _POLL_FIRST_S
-                if heartbeat is None:
-                    heartbeat = _Heartbeat(store, owner, lease_s)
-                description = ex.description
-                for record in ex.map_unordered(task, feed(first, submitted, limit)):
-                    if not store.put(record):
-                        # Another run stored this design meanwhile (it took over a claim of ours): its row rules.
-                        record = store.get_keys([record.key], fp).get(record.key) or record
-                    compute_time += record.wall_time_s or 0.0
-                    settle(record, waited=False)
-        except BaseException:
-            _finish(store, owner, state["claimed"], heartbeat, ex if executor is None else None, bar, quiet=True)
-            raise
-        _finish(store, owner, state["claimed"], heartbeat, ex if executor is None else None, bar, quiet=False)
-
-    statuses = [found[k].status for k in unique]
+def _sampling_result(request: _Request, work: CooperativeEvaluation, start: float) -> SamplingResult:
+    """The result of a call that began at ``start`` (``time.perf_counter()``, s), once every design is settled."""
+    statuses = [work.found[k].status for k in request.unique]
     return SamplingResult(
-        records=[found[k] for k in keys],
-        n_requested=len(requested),
-        n_unique=len(unique),
-        n_cached=n_cached,
-        n_computed=counts["computed"],
+        records=[work.found[k] for k in request.keys],
+        n_requested=len(request.designs),
+        n_unique=len(request.unique),
+        n_cached=work.n_cached,
+        n_computed=work.counts["computed"],
         n_failed=statuses.count("failed"),
         n_infeasible=statuses.count("infeasible"),
-        n_waited=counts["waited"],
+        n_waited=work.counts["waited"],
         wall_time_s=time.perf_counter() - start,
-        compute_time_s=compute_time,
-        executor=description,
+        compute_time_s=work.compute_time_s,
+        executor=work.description,
     )
-
-
-def _finish(
-    store: SampleStore,
-    owner: str,
-    claimed: bool,
-    heartbeat: _Heartbeat | None,
-    own_executor: SampleExecutor | None,
-    bar: Any,
-    quiet: bool,
-) -> None:
-    """Stop the heartbeat, release this run's claims, close an executor we created, close the bar.
-
-    With ``quiet`` (an exception is on its way out) a failure to release is ignored: the claims then lapse after
-    their lease, and the original error is the one to show.
-    """
-    try:
-        if heartbeat is not None:
-            heartbeat.stop()
-        if claimed:
-            try:
-                store.release_claims(owner)
-            except MechoptError:
-                if not quiet:
-                    raise
-    finally:
-        try:
-            if own_executor is not None:
-                own_executor.close()
-        finally:
-            bar.close()

@@ -15,28 +15,43 @@ Claims (table ``claims``) let concurrent runs on one file share the work instead
 claims the designs it is about to evaluate, with a lease it renews while alive; another run leaves validly claimed
 designs alone and waits for their results, and takes a claim over once its lease has expired (or, on the same host,
 as soon as the claiming process is gone).
+
+:class:`SampleStore` is the one interface; it composes the parts that live in their own modules: the record and its
+key (``sample_record.py``), the file's layout (``store_schema.py``), the connection with its transactions and
+one-line errors (``store_connection.py``), the queries of the ``samples`` table (``sample_rows.py``) and the claims
+(``claims.py``).
 """
 
 from __future__ import annotations
 
-import json
-import math
-import os
-import socket
 import sqlite3
-import tempfile
-import time
-import uuid
-from collections.abc import Iterable, Iterator, Sequence
-from contextlib import contextmanager
-from dataclasses import dataclass, field
-from datetime import UTC, datetime
-from itertools import islice
+from collections.abc import Iterable, Sequence
 from pathlib import Path
-from typing import Any
-from urllib.parse import quote
 
 from mechopt.errors import InputError
+from mechopt.runs.claims import (
+    Claim,
+    claim_keys,
+    drop_claims,
+    list_claims,
+    new_owner,
+    release_claims,
+    renew_claims,
+    unique_keys,
+)
+from mechopt.runs.sample_record import KEY_DECIMALS, STATUSES, SampleRecord, as_design, design_key, utc_timestamp
+from mechopt.runs.sample_rows import (
+    count_rows,
+    delete_failed,
+    fingerprint_counts,
+    insert_rows,
+    record_row,
+    select_keys,
+    select_rows,
+    status_filter,
+)
+from mechopt.runs.store_connection import StoreConnection
+from mechopt.runs.store_schema import SCHEMA_VERSION
 
 __all__ = [
     "KEY_DECIMALS",
@@ -50,252 +65,6 @@ __all__ = [
     "new_owner",
     "utc_timestamp",
 ]
-
-#: Decimal places of the canonical design key: 1e-9 (mm, rad...) is far below any manufacturing tolerance and far
-#: above the float noise of values of a few hundred units (~1e-13).
-KEY_DECIMALS = 9
-
-#: Allowed values of :attr:`SampleRecord.status`.
-STATUSES = ("ok", "infeasible", "failed")
-
-#: Version of the file layout, kept in ``PRAGMA user_version`` and in the ``meta`` table.  Version 1 was mechopt
-#: 0.1's four-bar layout (columns oa, ab, bc, t_rms, t_max).
-SCHEMA_VERSION = 2
-
-# SQLite's historical limit on bound parameters is 999; stay below it in IN (...) queries.
-_CHUNK = 500
-
-_SCHEMA = (
-    """
-    CREATE TABLE IF NOT EXISTS meta (
-        name  TEXT PRIMARY KEY,
-        value TEXT NOT NULL
-    )""",
-    """
-    CREATE TABLE IF NOT EXISTS samples (
-        id          INTEGER PRIMARY KEY,
-        fingerprint TEXT NOT NULL,
-        key         TEXT NOT NULL,
-        design      TEXT NOT NULL,
-        status      TEXT NOT NULL CHECK (status IN ('ok', 'infeasible', 'failed')),
-        outputs     TEXT NOT NULL DEFAULT '{}',
-        error       TEXT,
-        wall_time_s REAL,
-        timestamp   TEXT NOT NULL,
-        UNIQUE (fingerprint, key)
-    )""",
-    """
-    CREATE TABLE IF NOT EXISTS claims (
-        fingerprint TEXT NOT NULL,
-        key         TEXT NOT NULL,
-        owner       TEXT NOT NULL,
-        expires     REAL NOT NULL,
-        PRIMARY KEY (fingerprint, key)
-    )""",
-    "CREATE INDEX IF NOT EXISTS claims_by_owner ON claims (owner)",
-)
-
-_TABLES = {"meta", "samples", "claims"}
-
-_COLUMNS = "design, fingerprint, status, outputs, error, wall_time_s, timestamp"
-
-_OLD_STORE = (
-    "{path} was written by mechopt 0.1 (fixed four-bar columns); move it away or delete it, "
-    "its samples will be simulated again"
-)
-
-# Primary SQLite result codes (sqlite3.Error.sqlite_errorcode & 0xFF).
-_BUSY, _LOCKED, _READONLY, _IOERR, _CORRUPT, _FULL, _CANTOPEN, _NOTADB = 5, 6, 8, 10, 11, 13, 14, 26
-
-
-def as_design(design: Sequence[float], dim: int | None = None) -> tuple[float, ...]:
-    """Validate a design and return it as a tuple of floats.
-
-    Parameters
-    ----------
-    design : sequence of float
-        The design variables, in their units (mm, rad...).
-    dim : int, optional
-        Required number of values; any number >= 1 if omitted.
-
-    Returns
-    -------
-    tuple of float
-
-    Raises
-    ------
-    InputError
-        If the design is not a non-empty sequence of finite numbers (of length ``dim`` when given).
-    """
-    try:
-        values = tuple(float(x) for x in design)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"a design must be a sequence of numbers, got {design!r:.80}") from exc
-    if not values:
-        raise InputError("a design must have at least one value, got none")
-    if dim is not None and len(values) != dim:
-        raise InputError(f"a design must have {dim} values, got {len(values)}: {values!r:.80}")
-    if not all(math.isfinite(x) for x in values):
-        raise InputError(f"a design must have finite values, got {values!r:.80}")
-    return values
-
-
-def design_key(design: Sequence[float]) -> str:
-    """Canonical text key of a design, insensitive to float noise below 1e-9.
-
-    Parameters
-    ----------
-    design : sequence of float
-        Any number d >= 1 of values, in the variables' units.
-
-    Returns
-    -------
-    str
-        The values with :data:`KEY_DECIMALS` decimals, comma-separated, e.g. ``"100.000000000,250.000000000"``.
-
-    Raises
-    ------
-    InputError
-        If the design is not a non-empty sequence of finite numbers.
-    """
-    # ``+ 0.0`` turns -0.0 into 0.0 so that both print the same.
-    return ",".join(f"{x + 0.0:.{KEY_DECIMALS}f}" for x in as_design(design))
-
-
-def new_owner() -> str:
-    """A claim owner id unique to one call: ``"HOST/PID/UUID"``.
-
-    The host and process id let a run on the same host take over at once the claims of a process that is gone
-    (killed with SIGKILL), instead of waiting for their leases to expire.
-    """
-    return f"{socket.gethostname()}/{os.getpid()}/{uuid.uuid4().hex}"
-
-
-def _owner_is_gone(owner: str) -> bool:
-    """Whether ``owner`` (:func:`new_owner`) names a process of this host that no longer exists."""
-    host, _, rest = owner.partition("/")
-    pid_text = rest.partition("/")[0]
-    if host != socket.gethostname() or not pid_text.isdigit():
-        return False  # another host (or a foreign id): only its lease tells
-    try:
-        os.kill(int(pid_text), 0)
-    except ProcessLookupError:
-        return True
-    except OSError:
-        return False  # exists, owned by another user
-    return False
-
-
-def utc_timestamp() -> str:
-    """Now as an ISO 8601 UTC timestamp with milliseconds, e.g. ``2026-01-31T12:00:00.123Z`` (sorts as text)."""
-    return datetime.now(UTC).isoformat(timespec="milliseconds").replace("+00:00", "Z")
-
-
-def _one_line(text: str) -> str:
-    return " ".join(str(text).split())
-
-
-@dataclass(frozen=True)
-class SampleRecord:
-    """One evaluated design.
-
-    Attributes
-    ----------
-    design : tuple of float
-        The design as first requested, in the variables' units (float noise below 1e-9 maps to the same
-        :attr:`key`).
-    fingerprint : str
-        Hash of the problem and settings the design was evaluated with (``DesignProblem.fingerprint()``).
-    status : str
-        ``"ok"``, ``"infeasible"`` (the evaluator raised ``InfeasibleDesignError``) or ``"failed"`` (any other
-        error, or an unusable return value).
-    outputs : dict
-        Everything the evaluator returned (JSON values); empty unless ``status == "ok"``.
-    error : str or None
-        One-line message for ``infeasible`` and ``failed`` records.
-    wall_time_s : float or None
-        Wall time of the evaluator call in s, measured in the worker.
-    timestamp : str
-        ISO 8601 UTC time when the result was known.
-    """
-
-    design: tuple[float, ...]
-    fingerprint: str
-    status: str
-    outputs: dict[str, Any] = field(default_factory=dict)
-    error: str | None = None
-    wall_time_s: float | None = None
-    timestamp: str = field(default_factory=utc_timestamp)
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "design", as_design(self.design))
-        if self.status not in STATUSES:
-            raise InputError(f"status must be one of {', '.join(STATUSES)}, got {self.status!r}")
-        if not isinstance(self.fingerprint, str) or not self.fingerprint:
-            raise InputError(f"a record needs a fingerprint string, got {self.fingerprint!r}")
-        if not isinstance(self.outputs, dict):
-            raise InputError(f"outputs must be a dict, got {type(self.outputs).__name__}")
-        if self.outputs and self.status != "ok":
-            raise InputError(f"a {self.status!r} record has no outputs, got {sorted(self.outputs)}")
-
-    @property
-    def key(self) -> str:
-        """Canonical key of the design (:func:`design_key`)."""
-        return design_key(self.design)
-
-    @property
-    def ok(self) -> bool:
-        """Whether the evaluation succeeded."""
-        return self.status == "ok"
-
-    def value(self, name: str) -> float:
-        """One output as a float.
-
-        Parameters
-        ----------
-        name : str
-            Output name, e.g. ``"t_rms"``.
-
-        Returns
-        -------
-        float
-            The output, in the evaluator's unit; NaN unless the record is ``ok`` and has a numeric output ``name``.
-        """
-        if not self.ok:
-            return math.nan
-        value = self.outputs.get(name)
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            return math.nan
-        return float(value)
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON-able dict of the record (for ``result.json`` and reports).
-
-        Returns
-        -------
-        dict
-            All attributes, the design as a list, plus ``key``.
-        """
-        return {
-            "design": list(self.design),
-            "key": self.key,
-            "fingerprint": self.fingerprint,
-            "status": self.status,
-            "outputs": dict(self.outputs),
-            "error": self.error,
-            "wall_time_s": self.wall_time_s,
-            "timestamp": self.timestamp,
-        }
-
-
-@dataclass(frozen=True)
-class Claim:
-    """A design a run is evaluating: other runs leave it alone until ``expires`` (s since the epoch, UTC)."""
-
-    fingerprint: str
-    key: str
-    owner: str
-    expires: float
 
 
 class SampleStore:
@@ -326,167 +95,20 @@ class SampleStore:
     """
 
     def __init__(self, path: str | Path, *, timeout: float = 30.0) -> None:
-        self.path = Path(path)
-        self.timeout = float(timeout)
-        self._conn: sqlite3.Connection | None = None
+        self._db = StoreConnection(Path(path), float(timeout))
+        # Fixed once the file is open.
+        self.path, self.timeout = self._db.path, self._db.timeout
         #: Why the store cannot be written to (None if it can).
-        self.read_only: str | None = None
-        existed = self.path.exists()
-        if existed and not self.path.is_file():
-            raise InputError(f"the sample store {self.path} is not a file")
-        try:
-            self._open_read_write(existed)
-        except sqlite3.DatabaseError as exc:
-            self.close()
-            code = _code(exc)
-            if existed and code in (_READONLY, _CANTOPEN):
-                self._open_read_only()
-            elif not existed and code in (_READONLY, _CANTOPEN):
-                raise InputError(f"cannot create the sample store {self.path}: {_why_read_only(self.path)}") from exc
-            else:
-                raise self._error(exc, "opening it") from exc
-        except BaseException:
-            self.close()
-            raise
-
-    # -- opening ------------------------------------------------------------------------------------------------
-
-    def _open_read_write(self, existed: bool) -> None:
-        if not existed:
-            try:
-                self.path.parent.mkdir(parents=True, exist_ok=True)
-            except OSError as exc:
-                raise InputError(f"cannot create the folder of the sample store {self.path}: {exc}") from exc
-        # Autocommit mode: every statement outside an explicit BEGIN is its own committed transaction.
-        self._conn = sqlite3.connect(self.path, timeout=self.timeout, isolation_level=None)
-        conn = self._conn
-        deadline = time.monotonic() + self.timeout
-        delay = 0.005
-        while True:
-            # Switching a fresh database into WAL mode takes an exclusive lock and SQLite may report SQLITE_BUSY at
-            # once, without waiting on the busy timeout, when several processes open the same new file together.
-            try:
-                # WAL lets readers (a progress monitor, a second study) work while a run writes.
-                conn.execute("PRAGMA journal_mode = WAL")
-                # In WAL mode NORMAL loses no committed transaction when the *process* dies (only on power loss),
-                # and avoids an fsync per result.
-                conn.execute("PRAGMA synchronous = NORMAL")
-                if self._check_schema():
-                    return
-                with self._transaction():
-                    if self._check_schema():
-                        return
-                    for statement in _SCHEMA:
-                        conn.execute(statement)
-                    conn.executemany(
-                        "INSERT OR REPLACE INTO meta (name, value) VALUES (?, ?)",
-                        [("schema_version", str(SCHEMA_VERSION)), ("created", utc_timestamp())],
-                    )
-                    conn.execute(f"PRAGMA user_version = {SCHEMA_VERSION}")
-                return
-            except sqlite3.OperationalError as exc:
-                if _code(exc) not in (_BUSY, _LOCKED) or time.monotonic() > deadline:
-                    raise
-                time.sleep(delay)
-                delay = min(2 * delay, 0.2)
-
-    def _open_read_only(self) -> None:
-        """Open a store that cannot be written: its file, or its folder (no room for the WAL files), is read-only."""
-        self.read_only = _why_read_only(self.path)
-        uri = "file:" + quote(str(self.path.resolve()))
-        # mode=ro reads a WAL file whose -wal/-shm exist or can be created; in a read-only folder they cannot, and
-        # only immutable=1 opens it — safe there, since no writer can create the WAL it would need either.
-        for suffix in ("?mode=ro", "?immutable=1"):
-            try:
-                self._conn = sqlite3.connect(uri + suffix, uri=True, timeout=self.timeout, isolation_level=None)
-                if not self._check_schema():
-                    raise InputError(f"the sample store {self.path} is empty and {self.read_only}")
-                return
-            except sqlite3.DatabaseError as exc:
-                self.close()
-                if _code(exc) == _CANTOPEN and suffix != "?immutable=1":
-                    continue
-                raise self._error(exc, "opening it read-only") from exc
-            except BaseException:
-                self.close()
-                raise
-
-    def _check_schema(self) -> bool:
-        """True if the file holds the current schema, False if it is empty; InputError if it holds anything else."""
-        conn = self._c
-        version = conn.execute("PRAGMA user_version").fetchone()[0]
-        tables = {row[0] for row in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
-        columns = {row[1] for row in conn.execute("PRAGMA table_info(samples)")} if "samples" in tables else set()
-        if version == 1 or {"oa", "settings_hash"} & columns:
-            raise InputError(_OLD_STORE.format(path=self.path))
-        if version > SCHEMA_VERSION:
-            raise InputError(
-                f"the sample store {self.path} was written by a newer mechopt (schema {version}, this one reads "
-                f"{SCHEMA_VERSION}); upgrade mechopt or use another --store"
-            )
-        if version == SCHEMA_VERSION and _TABLES <= tables:
-            return True
-        if tables:
-            raise InputError(
-                f"{self.path} is not a mechopt sample store (it holds the tables {', '.join(sorted(tables))}); "
-                "give another --store"
-            )
-        return False
-
-    # -- plumbing -----------------------------------------------------------------------------------------------
+        self.read_only: str | None = self._db.read_only
 
     @property
     def _c(self) -> sqlite3.Connection:
-        if self._conn is None:
-            raise InputError(f"the sample store {self.path} is closed")
-        return self._conn
-
-    def _transaction(self) -> _Transaction:
-        return _Transaction(self._c)
-
-    def _error(self, exc: sqlite3.DatabaseError, doing: str) -> InputError:
-        """The one-line error a user sees for an SQLite error while ``doing`` something."""
-        code = _code(exc)
-        detail = _one_line(str(exc))
-        if code in (_BUSY, _LOCKED):
-            return InputError(
-                f"the sample store {self.path} is locked by another process (waited {self.timeout:g} s while "
-                f"{doing}); try again when it is done"
-            )
-        if code == _READONLY:
-            return InputError(f"cannot write to the sample store {self.path}: {_why_read_only(self.path)}")
-        if code == _FULL:
-            return InputError(f"the disk of the sample store {self.path} is full ({doing})")
-        if code == _CANTOPEN:
-            return InputError(f"cannot open the sample store {self.path}: {detail}")
-        if code == _IOERR:
-            return InputError(f"cannot read or write the sample store {self.path} ({detail} while {doing})")
-        return InputError(
-            f"{self.path} is not a usable sample store ({detail} while {doing}); move it away or delete it, "
-            "its samples will be simulated again"
-        )
-
-    @contextmanager
-    def _sql(self, doing: str, write: bool = False) -> Iterator[sqlite3.Connection]:
-        """The connection, with every SQLite error (a corrupt page met mid-file included) turned into one line."""
-        if write and self.read_only:
-            raise InputError(f"cannot write to the sample store {self.path}: {self.read_only}")
-        conn = self._c
-        try:
-            yield conn
-        except sqlite3.DatabaseError as exc:
-            raise self._error(exc, doing) from exc
-        except _BadRow as exc:
-            raise InputError(
-                f"{self.path} is not a usable sample store (unreadable row: {_one_line(str(exc))}); move it away "
-                "or delete it, its samples will be simulated again"
-            ) from exc
+        """The raw connection, for checks of the file's settings."""
+        return self._db.conn
 
     def close(self) -> None:
         """Close the database connection (idempotent)."""
-        if self._conn is not None:
-            self._conn.close()
-            self._conn = None
+        self._db.close()
 
     def __enter__(self) -> SampleStore:
         return self
@@ -496,8 +118,6 @@ class SampleStore:
 
     def __repr__(self) -> str:
         return f"SampleStore({str(self.path)!r}{', read-only' if self.read_only else ''})"
-
-    # -- writing ------------------------------------------------------------------------------------------------
 
     def put(self, record: SampleRecord) -> bool:
         """Store one record and commit it; any claim on its design is dropped in the same transaction.
@@ -533,25 +153,12 @@ class SampleStore:
         int
             Number of records actually inserted.
         """
-        rows = []
-        for r in records:
-            try:
-                outputs = json.dumps(r.outputs, sort_keys=True)
-            except (TypeError, ValueError) as exc:
-                raise InputError(f"the outputs of design {r.key} are not JSON-serializable: {exc}") from exc
-            rows.append((r.fingerprint, r.key, json.dumps(list(r.design)), r.status, outputs, r.error,
-                         r.wall_time_s, r.timestamp))
+        rows = [record_row(r) for r in records]
         if not rows:
             return 0
-        with self._sql("storing results", write=True) as conn, self._transaction():
-            before = conn.total_changes
-            conn.executemany(
-                "INSERT OR IGNORE INTO samples (fingerprint, key, design, status, outputs, error, wall_time_s,"
-                " timestamp) VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
-                rows,
-            )
-            inserted = conn.total_changes - before
-            conn.executemany("DELETE FROM claims WHERE fingerprint = ? AND key = ?", [r[:2] for r in rows])
+        with self._db.write("storing results") as conn:
+            inserted = insert_rows(conn, rows)
+            drop_claims(conn, [r[:2] for r in rows])
             return inserted
 
     def forget_failed(self, fingerprint: str) -> int:
@@ -567,12 +174,8 @@ class SampleStore:
         int
             Number of records deleted.
         """
-        with self._sql("deleting failed records", write=True) as conn, self._transaction():
-            return conn.execute(
-                "DELETE FROM samples WHERE fingerprint = ? AND status = 'failed'", (fingerprint,)
-            ).rowcount
-
-    # -- claims -------------------------------------------------------------------------------------------------
+        with self._db.write("deleting failed records") as conn:
+            return delete_failed(conn, fingerprint)
 
     def claim(
         self,
@@ -614,59 +217,8 @@ class SampleStore:
             raise InputError(f"lease_s must be a positive number of seconds, got {lease_s!r}")
         if limit is not None and limit < 1:
             return []
-        todo = _unique(keys)
-        # Without contention the first few keys are claimable: look at a few, then at more and more.
-        size = _CHUNK if limit is None else min(_CHUNK, max(32, 2 * limit))
-        taken: list[str] = []
-        with self._sql("claiming designs", write=True) as conn, self._transaction():
-            now = time.time()
-            gone: dict[str, bool] = {}
-            while limit is None or len(taken) < limit:
-                chunk = list(islice(todo, size))
-                if not chunk:
-                    break
-                size = min(2 * size, _CHUNK)
-                marks = ",".join("?" * len(chunk))
-                args = [fingerprint, *chunk]
-                stored = {
-                    key: (status, stamp)
-                    for key, status, stamp in conn.execute(
-                        f"SELECT key, status, timestamp FROM samples WHERE fingerprint = ? AND key IN ({marks})", args
-                    )
-                }
-                held = {
-                    key: (who, expires)
-                    for key, who, expires in conn.execute(
-                        f"SELECT key, owner, expires FROM claims WHERE fingerprint = ? AND key IN ({marks})", args
-                    )
-                }
-                redo = []
-                for key in chunk:
-                    if limit is not None and len(taken) >= limit:
-                        break
-                    if key in stored:
-                        status, stamp = stored[key]
-                        if not (redo_failed_before and status == "failed" and stamp < redo_failed_before):
-                            continue
-                    if key in held:
-                        who, expires = held[key]
-                        if who != owner and expires > now:
-                            if who not in gone:
-                                gone[who] = _owner_is_gone(who)
-                            if not gone[who]:
-                                continue
-                    taken.append(key)
-                    if key in stored:
-                        redo.append(key)
-                conn.executemany(
-                    "DELETE FROM samples WHERE fingerprint = ? AND key = ? AND status = 'failed'",
-                    [(fingerprint, k) for k in redo],
-                )
-            conn.executemany(
-                "INSERT OR REPLACE INTO claims (fingerprint, key, owner, expires) VALUES (?, ?, ?, ?)",
-                [(fingerprint, k, owner, now + lease_s) for k in taken],
-            )
-        return taken
+        with self._db.write("claiming designs") as conn:
+            return claim_keys(conn, fingerprint, unique_keys(keys), owner, lease_s, limit, redo_failed_before)
 
     def renew_claims(self, owner: str, lease_s: float) -> int:
         """Extend every claim of ``owner`` to ``lease_s`` seconds from now (the heartbeat of a live run).
@@ -676,10 +228,8 @@ class SampleStore:
         int
             Number of claims renewed.
         """
-        with self._sql("renewing claims", write=True) as conn, self._transaction():
-            return conn.execute(
-                "UPDATE claims SET expires = ? WHERE owner = ?", (time.time() + lease_s, owner)
-            ).rowcount
+        with self._db.write("renewing claims") as conn:
+            return renew_claims(conn, owner, lease_s)
 
     def release_claims(self, owner: str, keys: Iterable[str] | None = None) -> int:
         """Drop claims of ``owner``: all of them, or those of ``keys``.
@@ -689,12 +239,8 @@ class SampleStore:
         int
             Number of claims dropped.
         """
-        with self._sql("releasing claims", write=True) as conn, self._transaction():
-            if keys is None:
-                return conn.execute("DELETE FROM claims WHERE owner = ?", (owner,)).rowcount
-            before = conn.total_changes
-            conn.executemany("DELETE FROM claims WHERE owner = ? AND key = ?", [(owner, k) for k in keys])
-            return conn.total_changes - before
+        with self._db.write("releasing claims") as conn:
+            return release_claims(conn, owner, keys)
 
     def claims(self, fingerprint: str | None = None) -> list[Claim]:
         """Current claims (valid or expired), oldest lease end first.
@@ -708,14 +254,8 @@ class SampleStore:
         -------
         list of Claim
         """
-        where, args = ("WHERE fingerprint = ?", [fingerprint]) if fingerprint is not None else ("", [])
-        with self._sql("reading claims") as conn:
-            rows = conn.execute(
-                f"SELECT fingerprint, key, owner, expires FROM claims {where} ORDER BY expires, key", args
-            ).fetchall()
-        return [Claim(*row) for row in rows]
-
-    # -- reading ------------------------------------------------------------------------------------------------
+        with self._db.sql("reading claims") as conn:
+            return list_claims(conn, fingerprint)
 
     def get(self, design: Sequence[float], fingerprint: str) -> SampleRecord | None:
         """The stored record of one design, or None.
@@ -752,19 +292,9 @@ class SampleStore:
 
     def get_keys(self, keys: Iterable[str], fingerprint: str) -> dict[str, SampleRecord]:
         """The stored records of several design keys (:func:`design_key`): key -> record, for those found."""
-        keys = list(dict.fromkeys(keys))
-        found: dict[str, SampleRecord] = {}
-        with self._sql("reading records") as conn:
-            for start in range(0, len(keys), _CHUNK):
-                chunk = keys[start : start + _CHUNK]
-                marks = ",".join("?" * len(chunk))
-                rows = conn.execute(
-                    f"SELECT key, {_COLUMNS} FROM samples WHERE fingerprint = ? AND key IN ({marks})",
-                    [fingerprint, *chunk],
-                ).fetchall()
-                for row in rows:
-                    found[row[0]] = _row_to_record(row[1:])
-        return found
+        distinct = list(dict.fromkeys(keys))
+        with self._db.sql("reading records") as conn:
+            return select_keys(conn, distinct, fingerprint)
 
     def missing(self, designs: Iterable[Sequence[float]], fingerprint: str) -> list[tuple[float, ...]]:
         """Designs not yet stored for this fingerprint, deduplicated by key, in first-seen order.
@@ -801,10 +331,9 @@ class SampleStore:
         -------
         list of SampleRecord
         """
-        where, args = _filter(fingerprint, status)
-        with self._sql("reading records") as conn:
-            rows = conn.execute(f"SELECT {_COLUMNS} FROM samples{where} ORDER BY id", args).fetchall()
-            return [_row_to_record(r) for r in rows]
+        where, args = status_filter(fingerprint, status)
+        with self._db.sql("reading records") as conn:
+            return select_rows(conn, where, args)
 
     def count(self, fingerprint: str | None = None, status: str | None = None) -> int:
         """Number of stored records.
@@ -820,9 +349,9 @@ class SampleStore:
         -------
         int
         """
-        where, args = _filter(fingerprint, status)
-        with self._sql("counting records") as conn:
-            return conn.execute(f"SELECT COUNT(*) FROM samples{where}", args).fetchone()[0]
+        where, args = status_filter(fingerprint, status)
+        with self._db.sql("counting records") as conn:
+            return count_rows(conn, where, args)
 
     def fingerprints(self) -> dict[str, int]:
         """Fingerprints present in the store with their number of records.
@@ -832,94 +361,5 @@ class SampleStore:
         dict
             fingerprint -> number of records, in order of first appearance.
         """
-        query = "SELECT fingerprint, COUNT(*) FROM samples GROUP BY fingerprint ORDER BY MIN(id)"
-        with self._sql("reading fingerprints") as conn:
-            return dict(conn.execute(query).fetchall())
-
-
-def _unique(keys: Iterable[str]) -> Iterator[str]:
-    """The keys without repeats, in order, read lazily."""
-    seen: set[str] = set()
-    for key in keys:
-        if key not in seen:
-            seen.add(key)
-            yield key
-
-
-def _code(exc: sqlite3.Error) -> int:
-    """Primary SQLite result code of an error (0 if unknown)."""
-    return (getattr(exc, "sqlite_errorcode", None) or 0) & 0xFF
-
-
-def _why_read_only(path: Path) -> str:
-    """Why ``path`` (or a file there) cannot be written: which of the file and its folder is read-only."""
-    if path.exists():
-        try:
-            os.close(os.open(path, os.O_RDWR))
-        except OSError:
-            return "the file is read-only"
-    try:
-        # The WAL files (-wal, -shm) live beside the database: the folder must take new files.
-        with tempfile.TemporaryFile(dir=path.parent):
-            pass
-    except OSError:
-        return "its folder is read-only (SQLite needs to create files beside it)"
-    return "it was opened read-only"
-
-
-def _filter(fingerprint: str | None, status: str | None) -> tuple[str, list[str]]:
-    clauses, args = [], []
-    if fingerprint is not None:
-        clauses.append("fingerprint = ?")
-        args.append(fingerprint)
-    if status is not None:
-        if status not in STATUSES:
-            raise InputError(f"status must be one of {', '.join(STATUSES)}, got {status!r}")
-        clauses.append("status = ?")
-        args.append(status)
-    return (" WHERE " + " AND ".join(clauses) if clauses else ""), args
-
-
-class _BadRow(ValueError):
-    """A row SQLite reads fine but whose content is not a record (damaged JSON, a hand-edited value)."""
-
-
-def _row_to_record(row: tuple) -> SampleRecord:
-    design, fingerprint, status, outputs, error, wall, stamp = row
-    try:
-        return SampleRecord(
-            design=tuple(json.loads(design)),
-            fingerprint=fingerprint,
-            status=status,
-            outputs=json.loads(outputs) if outputs else {},
-            error=error,
-            wall_time_s=wall,
-            timestamp=stamp,
-        )
-    except (TypeError, ValueError) as exc:
-        raise _BadRow(f"{exc} in the row of design {design!r:.60}") from exc
-
-
-class _Transaction:
-    """``BEGIN IMMEDIATE`` … ``COMMIT`` (or ``ROLLBACK``) on an autocommit connection.
-
-    IMMEDIATE takes the write lock up front, so a concurrent writer waits on the busy timeout at BEGIN instead of
-    failing later with SQLITE_BUSY on a lock upgrade that the timeout cannot resolve.
-    """
-
-    def __init__(self, conn: sqlite3.Connection) -> None:
-        self._conn = conn
-
-    def __enter__(self) -> None:
-        if self._conn.in_transaction:
-            # A KeyboardInterrupt between an earlier BEGIN and its `with` block left a transaction open.
-            self._conn.execute("ROLLBACK")
-        self._conn.execute("BEGIN IMMEDIATE")
-
-    def __exit__(self, exc_type: object, *rest: object) -> None:
-        if not self._conn.in_transaction:
-            return
-        if exc_type is None:
-            self._conn.execute("COMMIT")
-        else:
-            self._conn.execute("ROLLBACK")
+        with self._db.sql("reading fingerprints") as conn:
+            return fingerprint_counts(conn)

@@ -22,7 +22,8 @@ MECHANISMS: dict[str, str] = {
     "four-bar": "mechopt.studies.kinds.four_bar:problem_from_study",
     "offset-crank-slider": "mechopt.studies.kinds.offset_crank_slider:problem_from_study",
     "rowing": "mechopt.studies.kinds.rowing:problem_from_study",
-    "flexible-slider-crank": "mechopt.sim.flexible.problem:problem_from_study",
+    "flexible-slider-crank": "mechopt.studies.kinds.flexible_slider_crank:problem_from_study",
+    "flexible-four-bar": "mechopt.studies.kinds.flexible_four_bar:problem_from_study",
     "external": "mechopt.studies.kinds.external:problem_from_study",
 }
 

@@ -26,12 +26,21 @@ from mechopt.optimize.problem import DesignProblem, Variable
 __all__ = [
     "SUITE",
     "Branin",
+    "Ackley8",
     "CosineBowl3",
+    "CosineBowl4",
+    "FailingHartmann3",
     "Hartmann3",
+    "Hartmann4",
+    "Hartmann6",
+    "Levy8",
+    "Rosenbrock6",
+    "StyblinskiTang3",
     "HimmelblauDisc",
     "SixHumpCamel",
     "TestFunction",
     "dense_grid_range",
+    "sampled_range",
 ]
 
 
@@ -230,8 +239,193 @@ class HimmelblauDisc(TestFunction):
         return (x1**2 + x2 - 11) ** 2 + (x1 + x2**2 - 7) ** 2
 
 
+def _axes(prefix: str, dim: int, lower: float, upper: float) -> tuple[Variable, ...]:
+    return tuple(Variable(f"{prefix}{i + 1}", lower, upper) for i in range(dim))
+
+
+def sampled_range(problem: TestFunction, n: int, seed: int = 0) -> tuple[float, float]:
+    """Smallest and largest value found on ``n`` Sobol points, the 2^d corners and L-BFGS-B ascents from the 20
+    highest points: the range of a function whose dimension forbids a dense grid (d >= 5).
+
+    Parameters
+    ----------
+    problem : TestFunction
+    n : int
+        Sobol points (a power of 2 keeps the sequence balanced).
+    seed : int
+        Scrambling seed.
+
+    Returns
+    -------
+    (float, float)
+        min and max found.
+    """
+    from scipy.stats import qmc
+
+    b = problem.bounds
+    width = b[:, 1] - b[:, 0]
+    U = qmc.Sobol(problem.dim, seed=seed).random(n)
+    corners = np.array(np.meshgrid(*[[0.0, 1.0]] * problem.dim, indexing="ij")).reshape(problem.dim, -1).T
+    U = np.vstack([U, corners])
+    f = problem(b[:, 0] + U * width)
+    for u0 in U[np.argsort(f)[-20:]]:
+        res = minimize(lambda u: -float(problem(b[:, 0] + u * width)[0]), u0, method="L-BFGS-B",
+                       bounds=[(0, 1)] * problem.dim)
+        f = np.append(f, -res.fun)
+    return float(f.min()), float(f.max())
+
+
+class _Hartmann(TestFunction):
+    """−Σ c_i exp(−Σ_j A_ij (x_j − P_ij)²) on [0, 1]^d with the 4 × 6 tables of Dixon & Szegő (1978)."""
+
+    _A = np.array([[10, 3, 17, 3.5, 1.7, 8], [0.05, 10, 17, 0.1, 8, 14], [3, 3.5, 1.7, 10, 17, 8],
+                   [17, 8, 0.05, 10, 0.1, 14]], dtype=float)
+    _C = np.array([1.0, 1.2, 3.0, 3.2])
+    _P = 1e-4 * np.array([[1312, 1696, 5569, 124, 8283, 5886], [2329, 4135, 8307, 3736, 1004, 9991],
+                          [2348, 1451, 3522, 2883, 3047, 6650], [4047, 8828, 8732, 5743, 1091, 381]], dtype=float)
+
+    def function(self, X: np.ndarray) -> np.ndarray:
+        d = X.shape[1]
+        A, P = self._A[:, :d], self._P[:, :d]
+        inner = np.einsum("jk,njk->nj", A, (X[:, None, :] - P[None, :, :]) ** 2)
+        return -np.exp(-inner) @ self._C
+
+
+class Hartmann4(_Hartmann):
+    """Hartmann-4 (the first four columns of Hartmann-6's tables) on [0, 1]^4: global −3.72984."""
+
+    name = "hartmann4"
+    variables = _axes("x", 4, 0.0, 1.0)
+    f_min = -3.7298406  # L-BFGS-B from the 30 best of 20 000 random points
+    x_min = np.array([[0.187395, 0.194152, 0.557918, 0.264780]])
+    f_second = -3.5301  # the other minimum L-BFGS-B descents from 400 random starts end at
+    f_range = 3.7285  # dense_grid_range(Hartmann4(), 61): max −1.30e-3 minus f_min
+    range_grid = 61
+
+
+class Hartmann6(_Hartmann):
+    """Hartmann-6 on [0, 1]^6: six local minima, global −3.32237 at (0.20169, 0.15001, 0.47687, 0.27533, 0.31165,
+    0.6573)."""
+
+    name = "hartmann6"
+    variables = _axes("x", 6, 0.0, 1.0)
+    f_min = -3.322368011391339
+    x_min = np.array([[0.20168952, 0.15001069, 0.47687398, 0.27533243, 0.31165162, 0.65730054]])
+    f_second = -3.2032
+    f_range = 3.3224  # sampled_range(Hartmann6(), 2**16): max −2.8e-8 minus f_min
+    range_grid = 0
+
+
+class CosineBowl4(TestFunction):
+    """Σ (x − 0.3)² − 0.3 Π cos(3π (x − 0.3)) on [0, 1]^4 (CosineBowl3 in 4-D): global −0.3 at (0.3, ..., 0.3)."""
+
+    name = "cosine_bowl4"
+    variables = _axes("x", 4, 0.0, 1.0)
+    f_min = -0.3
+    x_min = np.array([[0.3, 0.3, 0.3, 0.3]])
+    f_second = np.nan
+    f_range = 2.1499  # dense_grid_range(CosineBowl4(), 61): max 1.84989 minus f_min
+    range_grid = 61
+
+    def function(self, X: np.ndarray) -> np.ndarray:
+        t = X - 0.3
+        return np.sum(t * t, axis=1) - 0.3 * np.prod(np.cos(3.0 * np.pi * t), axis=1)
+
+
+class StyblinskiTang3(TestFunction):
+    """Styblinski–Tang ½ Σ (x⁴ − 16 x² + 5 x) on [−5, 5]^3: 2^3 local minima, global −117.498 at x_i = −2.90353."""
+
+    name = "styblinski_tang3"
+    variables = _axes("x", 3, -5.0, 5.0)
+    f_min = -117.49849711131336
+    x_min = np.array([[-2.903534018185960] * 3])
+    f_second = -103.35  # two coordinates at −2.9035, one at the other minimum 2.7468
+    f_range = 492.50  # the maximum 375 at (5, 5, 5) minus f_min (the sum separates; checked on a 201^3 grid)
+    range_grid = 201
+
+    def function(self, X: np.ndarray) -> np.ndarray:
+        return 0.5 * np.sum(X**4 - 16.0 * X**2 + 5.0 * X, axis=1)
+
+
+class Rosenbrock6(TestFunction):
+    """Rosenbrock Σ 100 (x_{i+1} − x_i²)² + (1 − x_i)² on [−5, 10]^6: a curved valley, global 0 at (1, ..., 1)."""
+
+    name = "rosenbrock6"
+    variables = _axes("x", 6, -5.0, 10.0)
+    f_min = 0.0
+    x_min = np.ones((1, 6))
+    f_second = 3.9739  # the local minimum near (−0.99, 0.98, 0.97, 0.95, 0.90, 0.81) of d >= 4
+    f_range = 4.3429e6  # sampled_range(Rosenbrock6(), 2**16): max 4 342 905
+    range_grid = 0
+
+    def function(self, X: np.ndarray) -> np.ndarray:
+        return np.sum(100.0 * (X[:, 1:] - X[:, :-1] ** 2) ** 2 + (1.0 - X[:, :-1]) ** 2, axis=1)
+
+
+class Levy8(TestFunction):
+    """Levy on [−10, 10]^8: a ripple of sin² terms on a bowl, global 0 at (1, ..., 1)."""
+
+    name = "levy8"
+    variables = _axes("x", 8, -10.0, 10.0)
+    f_min = 0.0
+    x_min = np.ones((1, 8))
+    f_second = np.nan
+    f_range = 573.93  # sampled_range(Levy8(), 2**16): max 573.930
+    range_grid = 0
+
+    def function(self, X: np.ndarray) -> np.ndarray:
+        w = 1.0 + (X - 1.0) / 4.0
+        head = np.sin(np.pi * w[:, 0]) ** 2
+        body = np.sum((w[:, :-1] - 1.0) ** 2 * (1.0 + 10.0 * np.sin(np.pi * w[:, :-1] + 1.0) ** 2), axis=1)
+        tail = (w[:, -1] - 1.0) ** 2 * (1.0 + np.sin(2.0 * np.pi * w[:, -1]) ** 2)
+        return head + body + tail
+
+
+class Ackley8(TestFunction):
+    """Ackley on [−10, 30]^8: a near-flat plateau of ripples around one funnel, global 0 at the origin.
+
+    The box is shifted from the usual symmetric one so that no method finds the minimum by starting at the box's
+    centre.
+    """
+
+    name = "ackley8"
+    variables = _axes("x", 8, -10.0, 30.0)
+    f_min = 0.0
+    x_min = np.zeros((1, 8))
+    f_second = np.nan
+    f_range = 22.202  # sampled_range(Ackley8(), 2**14): max 22.2023
+    range_grid = 0
+
+    def function(self, X: np.ndarray) -> np.ndarray:
+        rms = np.sqrt(np.mean(X * X, axis=1))
+        return -20.0 * np.exp(-0.2 * rms) - np.exp(np.mean(np.cos(2.0 * np.pi * X), axis=1)) + 20.0 + np.e
+
+
+class FailingHartmann3(Hartmann3):
+    """Hartmann-3 whose simulator fails in part of the box: ``evaluate`` raises where x1 > 0.85 and returns NaN
+    where x2 > 0.9 (the global minimum lies where it succeeds).
+
+    A hidden constraint: nothing declares the failing region, a method learns it from the failures.  ``f_range``
+    is Hartmann-3's over the succeeding part of the box.
+    """
+
+    name = "failing_hartmann3"
+    f_range = 3.8626  # a 201^3 grid of the succeeding part: max −1.8e-4 minus f_min
+    raise_above = 0.85
+    nan_above = 0.9
+
+    def evaluate(self, x: np.ndarray) -> dict[str, float]:
+        """The function at one design, or a failure: RuntimeError where x1 > 0.85, NaN where x2 > 0.9."""
+        if x[0] > self.raise_above:
+            raise RuntimeError(f"simulation diverged at x1 = {x[0]:.3f}")
+        if x[1] > self.nan_above:
+            return {"f": float("nan")}
+        return super().evaluate(x)
+
+
 #: The benchmark suite, by name.
 SUITE: dict[str, type[TestFunction]] = {
-    cls.name: cls for cls in (Hartmann3, CosineBowl3, Branin, SixHumpCamel, HimmelblauDisc)
+    cls.name: cls for cls in (Hartmann3, CosineBowl3, Branin, SixHumpCamel, HimmelblauDisc, Hartmann4, CosineBowl4,
+                              StyblinskiTang3, FailingHartmann3, Hartmann6, Rosenbrock6, Levy8, Ackley8)
 }
 

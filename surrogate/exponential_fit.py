@@ -258,6 +258,131 @@ def _check_samples(values: Any) -> np.ndarray:
     return y
 
 
+def _check_arguments(values: Any, order: int | None, method: str, solver: str, max_order: int) -> np.ndarray:
+    """The samples as a float array, after checking every argument of :func:`fit_exponential`."""
+    if method not in METHODS:
+        raise SurrogateError(f"method must be one of {METHODS}, got {method!r}")
+    if solver not in SOLVERS:
+        raise SurrogateError(f"solver must be one of {SOLVERS}, got {solver!r}")
+    y = _check_samples(values)
+    if order is not None:
+        if isinstance(order, bool) or int(order) != order or order < 1:
+            raise SurrogateError(f"order must be a positive integer, got {order!r}")
+        if y.size < 2 * int(order):
+            raise SurrogateError(
+                f"order n = {int(order)} needs at least 2n = {2 * int(order)} samples, got N = {y.size}"
+            )
+    if int(max_order) < 1:
+        raise SurrogateError(f"max_order must be >= 1, got {max_order!r}")
+    return y
+
+
+@dataclass(frozen=True, eq=False)
+class _SignalSubspace:
+    """What the fits of every order share: the samples, the SVD of their Hankel matrix and the residual weights.
+
+    Attributes
+    ----------
+    samples : (N,) array
+        T_0 .. T_{N−1} (data units).
+    scale : float
+        max |T_k| (data units).
+    basis : 2-D array
+        Singular vectors spanning the signal subspace (right ones for the matrix pencil, left ones for ESPRIT).
+    singular_values : (m,) array
+        Singular values of the Hankel matrix divided by the largest.
+    solver : str
+        ``"ls"`` or ``"tls"``.
+    weights : (N,) array
+        1 / max(|T_k|, 1 % of max |T|) (per data unit): they make the order criterion's residuals relative.
+    """
+
+    samples: np.ndarray
+    scale: float
+    basis: np.ndarray
+    singular_values: np.ndarray
+    solver: str
+    weights: np.ndarray
+
+    @classmethod
+    def of(cls, y: np.ndarray, scale: float, method: str, solver: str, n_max: int) -> _SignalSubspace:
+        """The subspace of samples ``y`` (max |y| = ``scale`` > 0) able to carry ``n_max`` terms."""
+        H = _hankel(y / scale, _pencil_parameter(y.size, method, n_max))
+        U, s, Vh = np.linalg.svd(H, full_matrices=False)
+        # Simulation noise is relative, and unweighted residuals let spare terms chase the noise where |T| is largest.
+        weights = 1.0 / np.maximum(np.abs(y), _WEIGHT_FLOOR * scale)
+        return cls(y, scale, Vh.T if method == "matrix_pencil" else U, s / s[0], solver, weights)
+
+    def fit_order(self, n: int) -> tuple[np.ndarray, np.ndarray, float, float]:
+        """Nodes, coefficients, rms residual (data units) and relative rms residual of order n."""
+        try:
+            z = _shift_nodes(self.basis, n, self.solver)
+        except np.linalg.LinAlgError:
+            z = np.full(n, np.nan + 0j)
+        if not np.all(np.isfinite(z)) or np.any(z == 0):
+            return z, np.full(n, np.nan + 0j), np.inf, np.inf
+        y = self.samples
+        beta = _coefficients(y, z)
+        resid = _evaluate_at_samples(z, beta, y.size) - y
+        rms = float(np.sqrt(np.mean(resid**2)))
+        rel = float(np.sqrt(np.mean((resid * self.weights) ** 2)))
+        if not (np.isfinite(rms) and np.isfinite(rel)):
+            return z, beta, np.inf, np.inf
+        return z, beta, rms, rel
+
+
+def _fit_given_order(sub: _SignalSubspace, order: int, label: str) -> tuple[ExponentialFit, str | None]:
+    """The fit of the caller's order, and the warning it deserves (None when it needs none)."""
+    z, beta, rms, _ = sub.fit_order(order)
+    if not np.isfinite(rms):
+        raise SurrogateError(
+            f"order n = {order} gives a degenerate {label} fit (zero or infinite node); try a smaller order"
+        )
+    message = f"order {order} given by the caller"
+    warning = None
+    if np.any(_negative_real(z)):
+        note = "negative real node(s): evaluated as β|z|^k cos(πk) between integers (Nyquist oscillation)"
+        warning = f"exponential fit of order {order}: {note}"
+        message += f"; {note}"
+    fit = ExponentialFit(z, beta, order, rms, label, message, sub.samples.size, sub.singular_values)
+    return fit, warning
+
+
+def _fit_automatic_order(sub: _SignalSubspace, max_order: int, label: str) -> tuple[ExponentialFit, str | None]:
+    """The fit of the order chosen as the module docstring says, and the warning it deserves (None: none)."""
+    N = sub.samples.size
+    rank = int(np.sum(sub.singular_values > _RANK_TOL))
+    n_max = max(1, min(max_order, (N - 2) // _DOF_PER_TERM, rank, sub.basis.shape[0] - 1, sub.basis.shape[1]))
+    candidates: dict[int, tuple[np.ndarray, np.ndarray, float]] = {}
+    scores: dict[int, float] = {}
+    admissible: dict[int, bool] = {}
+    for n in range(1, n_max + 1):
+        z, beta, rms, rel = sub.fit_order(n)
+        candidates[n] = (z, beta, rms)
+        scores[n] = rel * np.sqrt(N / max(N - _DOF_PER_TERM * n, 1))
+        admissible[n] = bool(
+            np.isfinite(rms)
+            and not np.any(_negative_real(z))
+            and np.all(np.isfinite(beta))
+            and _cancellation(z, beta, N, sub.scale) <= _CANCELLATION_LIMIT
+        )
+    pool = [n for n in scores if admissible[n]]
+    caveat = ""
+    if not pool:
+        pool = list(scores)
+        caveat = "; no order free of negative real nodes or cancellation, kept the best anyway"
+    best = min(scores[n] for n in pool)
+    threshold = (1.0 + _ORDER_TOLERANCE) * best + _EXACT_FLOOR
+    chosen = min(n for n in pool if scores[n] <= threshold)
+    z, beta, rms = candidates[chosen]
+    message = (
+        f"automatic order {chosen} of 1..{n_max}: relative noise estimate {scores[chosen]:.3g} "
+        f"(best {best:.3g}){caveat}"
+    )
+    warning = f"exponential fit: {message}" if caveat and np.any(_negative_real(z)) else None
+    return ExponentialFit(z, beta, chosen, rms, label, message, N, sub.singular_values, scores), warning
+
+
 def fit_exponential(
     values: Any,
     order: int | None = None,
@@ -289,22 +414,9 @@ def fit_exponential(
     SurrogateError
         NaN/inf samples, fewer than 2 samples, fewer than 2n samples for a forced order n, unknown method/solver.
     """
-    if method not in METHODS:
-        raise SurrogateError(f"method must be one of {METHODS}, got {method!r}")
-    if solver not in SOLVERS:
-        raise SurrogateError(f"solver must be one of {SOLVERS}, got {solver!r}")
-    y = _check_samples(values)
+    y = _check_arguments(values, order, method, solver, max_order)
     N = y.size
     label = f"{method}/{solver}"
-    if order is not None:
-        if isinstance(order, bool) or int(order) != order or order < 1:
-            raise SurrogateError(f"order must be a positive integer, got {order!r}")
-        order = int(order)
-        if N < 2 * order:
-            raise SurrogateError(f"order n = {order} needs at least 2n = {2 * order} samples, got N = {N}")
-    if int(max_order) < 1:
-        raise SurrogateError(f"max_order must be >= 1, got {max_order!r}")
-
     scale = float(np.max(np.abs(y)))
     if scale == 0.0:
         return ExponentialFit(
@@ -316,75 +428,13 @@ def fit_exponential(
             message="all samples are zero: empty model",
             n_samples=N,
         )
-
-    n_needed = order if order is not None else max(1, min(int(max_order), (N - 2) // _DOF_PER_TERM))
-    L = _pencil_parameter(N, method, n_needed)
-    H = _hankel(y / scale, L)
-    U, s, Vh = np.linalg.svd(H, full_matrices=False)
-    basis = Vh.T if method == "matrix_pencil" else U
-    sv = s / s[0]
-
-    # The order criterion measures residuals relative to |T_k| (floored at 1 % of max |T|): simulation noise is
-    # relative, and unweighted residuals let spare terms chase the noise where |T| is largest.
-    weights = 1.0 / np.maximum(np.abs(y), _WEIGHT_FLOOR * scale)
-
-    def fit_order(n: int) -> tuple[np.ndarray, np.ndarray, float, float]:
-        """Nodes, coefficients, rms residual (data units) and relative rms residual of order n."""
-        try:
-            z = _shift_nodes(basis, n, solver)
-        except np.linalg.LinAlgError:
-            z = np.full(n, np.nan + 0j)
-        if not np.all(np.isfinite(z)) or np.any(z == 0):
-            return z, np.full(n, np.nan + 0j), np.inf, np.inf
-        beta = _coefficients(y, z)
-        resid = _evaluate_at_samples(z, beta, N) - y
-        rms = float(np.sqrt(np.mean(resid**2)))
-        rel = float(np.sqrt(np.mean((resid * weights) ** 2)))
-        if not (np.isfinite(rms) and np.isfinite(rel)):
-            return z, beta, np.inf, np.inf
-        return z, beta, rms, rel
-
     if order is not None:
-        z, beta, rms, _ = fit_order(order)
-        if not np.isfinite(rms):
-            raise SurrogateError(
-                f"order n = {order} gives a degenerate {label} fit (zero or infinite node); try a smaller order"
-            )
-        message = f"order {order} given by the caller"
-        if np.any(_negative_real(z)):
-            note = "negative real node(s): evaluated as β|z|^k cos(πk) between integers (Nyquist oscillation)"
-            warnings.warn(f"exponential fit of order {order}: {note}", SurrogateWarning, stacklevel=2)
-            message += f"; {note}"
-        return ExponentialFit(z, beta, order, rms, label, message, N, sv)
-
-    rank = int(np.sum(sv > _RANK_TOL))
-    n_max = max(1, min(int(max_order), (N - 2) // _DOF_PER_TERM, rank, basis.shape[0] - 1, basis.shape[1]))
-    candidates: dict[int, tuple[np.ndarray, np.ndarray, float]] = {}
-    scores: dict[int, float] = {}
-    admissible: dict[int, bool] = {}
-    for n in range(1, n_max + 1):
-        z, beta, rms, rel = fit_order(n)
-        candidates[n] = (z, beta, rms)
-        scores[n] = rel * np.sqrt(N / max(N - _DOF_PER_TERM * n, 1))
-        admissible[n] = bool(
-            np.isfinite(rms)
-            and not np.any(_negative_real(z))
-            and np.all(np.isfinite(beta))
-            and _cancellation(z, beta, N, scale) <= _CANCELLATION_LIMIT
-        )
-    pool = [n for n in scores if admissible[n]]
-    caveat = ""
-    if not pool:
-        pool = list(scores)
-        caveat = "; no order free of negative real nodes or cancellation, kept the best anyway"
-    best = min(scores[n] for n in pool)
-    threshold = (1.0 + _ORDER_TOLERANCE) * best + _EXACT_FLOOR
-    chosen = min(n for n in pool if scores[n] <= threshold)
-    z, beta, rms = candidates[chosen]
-    message = (
-        f"automatic order {chosen} of 1..{n_max}: relative noise estimate {scores[chosen]:.3g} "
-        f"(best {best:.3g}){caveat}"
-    )
-    if caveat and np.any(_negative_real(z)):
-        warnings.warn(f"exponential fit: {message}", SurrogateWarning, stacklevel=2)
-    return ExponentialFit(z, beta, chosen, rms, label, message, N, sv, scores)
+        sub = _SignalSubspace.of(y, scale, method, solver, int(order))
+        fit, warning = _fit_given_order(sub, int(order), label)
+    else:
+        sub = _SignalSubspace.of(y, scale, method, solver, max(1, min(int(max_order), (N - 2) // _DOF_PER_TERM)))
+        fit, warning = _fit_automatic_order(sub, int(max_order), label)
+    if warning is not None:
+        # Issued here, not in the helpers, so that it points at the caller of fit_exponential.
+        warnings.warn(warning, SurrogateWarning, stacklevel=2)
+    return fit

@@ -16,7 +16,6 @@ samples as well as the fit does.
 
 from __future__ import annotations
 
-import json
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
@@ -28,9 +27,7 @@ from mechopt.surrogate.blending import ChebyshevBlend
 from mechopt.surrogate.errors import SurrogateError, SurrogateWarning
 from mechopt.surrogate.exponential_fit import METHODS, SOLVERS, ExponentialFit, fit_exponential
 from mechopt.surrogate.lines import LineHull, LinePlan
-
-_FORMAT = "mechopt.surrogate.SparseExponentialModel"
-_VERSION = 1
+from mechopt.surrogate.model_file import model_from_dict, model_to_dict, read_model, write_model
 
 
 def _check_line(i: int, sample: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -319,51 +316,22 @@ class SparseExponentialModel:
     __call__ = predict
 
     # ------------------------------------------------------------------------------------------------- JSON
+    # The format itself lives in surrogate/model_file.py, beside its version number.
     def to_dict(self) -> dict[str, Any]:
         """JSON-friendly representation of the options and the fitted model."""
         self._require_fit()
-        return {
-            "format": _FORMAT,
-            "version": _VERSION,
-            "options": {
-                "order": self.order if self.order is None or np.ndim(self.order) == 0 else list(self.order),
-                "method": self.method,
-                "solver": self.solver,
-                "max_order": self.max_order,
-                "cond_max": self.cond_max,
-                "extrapolation": self.extrapolation,
-            },
-            "plan": self.plan.to_dict(),
-            "shifts": self.shifts.tolist(),
-            "fits": [f.to_dict() for f in self.fits],
-            "blend": self.blend.to_dict(),
-        }
+        return model_to_dict(self)
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> SparseExponentialModel:
         """Inverse of :meth:`to_dict` (no refit)."""
-        if data.get("format") != _FORMAT:
-            raise SurrogateError(f"not a saved SparseExponentialModel (format {data.get('format')!r})")
-        if data.get("version") != _VERSION:
-            raise SurrogateError(f"unsupported model file version {data.get('version')!r}, expected {_VERSION}")
-        model = cls(**data["options"])
-        model.plan = LinePlan.from_dict(data["plan"])
-        model.fits = [ExponentialFit.from_dict(f) for f in data["fits"]]
-        model.shifts = np.asarray(data["shifts"], dtype=float)
-        model.blend = ChebyshevBlend.from_dict(data["blend"])
-        if len(model.fits) != model.plan.n_lines or model.shifts.size != model.plan.n_lines:
-            raise SurrogateError(f"saved model has {len(model.fits)} fits for {model.plan.n_lines} lines")
-        return model
+        return model_from_dict(cls, data)
 
     def save(self, path: str | Path) -> None:
         """Write the fitted model to a JSON file at ``path``."""
-        Path(path).write_text(json.dumps(self.to_dict(), indent=1))
+        write_model(self, path)
 
     @classmethod
     def load(cls, path: str | Path) -> SparseExponentialModel:
         """Read a model written by :meth:`save`."""
-        try:
-            data = json.loads(Path(path).read_text())
-        except (OSError, json.JSONDecodeError) as exc:
-            raise SurrogateError(f"cannot read model file {str(path)!r}: {exc}") from exc
-        return cls.from_dict(data)
+        return read_model(cls, path)

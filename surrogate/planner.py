@@ -291,6 +291,118 @@ def _evaluate(
     return best
 
 
+def _checked_box(lower: Any, upper: Any, n_lines: int, spacing: float | None, samples_per_line: int,
+                 min_samples: int, layout: str) -> tuple[np.ndarray, np.ndarray]:
+    """The box bounds as float vectors, after checking every option of :func:`plan_lines` that needs no probe."""
+    lo = np.asarray(lower, dtype=float).reshape(-1)
+    hi = np.asarray(upper, dtype=float).reshape(-1)
+    if lo.shape != hi.shape or lo.size not in (2, 3, 4):
+        raise SurrogateError(f"lower and upper must be vectors of length 2 to 4, got {lo.shape} and {hi.shape}")
+    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi)) and np.all(hi > lo)):
+        raise SurrogateError(f"need finite bounds with upper > lower, got lower={lo.tolist()}, upper={hi.tolist()}")
+    dim = lo.size
+    if layout not in LAYOUTS:
+        raise SurrogateError(f"layout must be one of {', '.join(LAYOUTS)}, got {layout!r}")
+    if layout == "boundary" and dim > 3:
+        raise SurrogateError(f"layout 'boundary' places nodes on a polygon (d <= 3); use 'fekete' for d = {dim}")
+    if int(n_lines) < dim:
+        raise SurrogateError(f"n_lines must be >= d = {dim} for the hull to have volume, got {n_lines}")
+    if spacing is not None and not (np.isfinite(spacing) and spacing > 0):
+        raise SurrogateError(f"spacing must be a positive length, got {spacing!r}")
+    if int(samples_per_line) < _MIN_RUN:
+        raise SurrogateError(f"samples_per_line must be >= {_MIN_RUN}, got {samples_per_line}")
+    if not _MIN_RUN <= int(min_samples) <= int(samples_per_line):
+        raise SurrogateError(
+            f"min_samples must be between {_MIN_RUN} and samples_per_line = {samples_per_line}, got {min_samples}"
+        )
+    return lo, hi
+
+
+def _ranking_probes(lo: np.ndarray, hi: np.ndarray, feasible: FeasiblePredicate, n_probe: int,
+                    rng: np.random.Generator) -> np.ndarray:
+    """The feasible ones of ``n_probe`` uniform points of the box; too few of them make the coverage meaningless."""
+    F = _probe(lo, hi, feasible, int(n_probe), rng)
+    if F.shape[0] < 10 * (lo.size + 1):
+        raise SurrogateError(
+            f"only {F.shape[0]} of {n_probe} probe points are feasible; enlarge n_probe or check the bounds"
+        )
+    return F
+
+
+def _candidate_directions(F: np.ndarray, lo: np.ndarray, hi: np.ndarray, n_random: int, directions: Any | None,
+                          rng: np.random.Generator) -> list[np.ndarray]:
+    """Unit directions to try: the caller's, or the cloud's principal axes, the coordinate axes and random ones.
+
+    The random directions are drawn even when the caller gives directions, so that the rest of the search sees the
+    same random stream either way.
+    """
+    dim = lo.size
+    # Work in box-normalised units so "principal axes" and "random directions" do not depend on the units.
+    width = hi - lo
+    Fn = (F - lo) / width
+    _, _, vt = np.linalg.svd(Fn - Fn.mean(axis=0), full_matrices=False)
+    cands = [v * width for v in vt] + list(np.eye(dim))
+    rand = rng.standard_normal((n_random, dim))
+    cands += [v * width for v in rand]
+    if directions is not None:
+        cands = [np.asarray(v, dtype=float).reshape(-1) for v in directions]
+        if any(v.shape != (dim,) or not np.linalg.norm(v) > 0 for v in cands):
+            raise SurrogateError(f"directions must be non-zero vectors of length {dim}")
+    return [v / np.linalg.norm(v) for v in cands]
+
+
+class _DirectionSearch:
+    """The best plan over the directions tried so far, each scored by :func:`_evaluate` on the ranking probes."""
+
+    def __init__(self, F_rank: np.ndarray, spacing: float | None, samples_per_line: int, runs_on: FeasiblePredicate,
+                 n_lines: int, min_samples: int, shrinks: tuple[float, ...], layout: str, rng: np.random.Generator):
+        self.F_rank = F_rank
+        self.spacing = spacing
+        self.samples_per_line = samples_per_line
+        self.runs_on = runs_on
+        self.n_lines = n_lines
+        self.min_samples = min_samples
+        self.shrinks = shrinks
+        self.layout = layout
+        self.rng = rng
+        self.best_cov = 0.0
+        self.best_plan: LinePlan | None = None
+        self.tried = 0
+
+    def try_direction(self, u: np.ndarray) -> None:
+        """Score the unit direction u and keep its plan if it covers more than the best so far."""
+        cov, plan = _evaluate(u, self.spacing, self.samples_per_line, self.F_rank, self.runs_on, self.n_lines,
+                              self.min_samples, self.shrinks, self.layout, self.rng)
+        self.tried += 1
+        if plan is not None and cov > self.best_cov:
+            self.best_cov, self.best_plan = cov, plan
+
+    def refine(self, n_refine: int) -> None:
+        """Try random perturbations of the best direction, coarse then fine (``n_refine`` in all)."""
+        dim = self.F_rank.shape[1]
+        for angle in (0.15, 0.05):
+            for _ in range(n_refine // 2):
+                u0 = self.best_plan.direction / self.best_plan.spacing
+                u = u0 + angle * self.rng.standard_normal(dim)
+                u /= np.linalg.norm(u)
+                self.try_direction(u)
+
+
+def _rescored(search: _DirectionSearch, lo: np.ndarray, hi: np.ndarray, feasible: FeasiblePredicate, n_probe: int,
+              n_lines: int, rng: np.random.Generator) -> PlanResult:
+    """The best plan with its coverage measured again on fresh probe points (the ranking ones favour it)."""
+    best_plan = search.best_plan
+    F2 = _probe(lo, hi, feasible, n_probe, rng)
+    cov = coverage(best_plan, F2) if F2.shape[0] else search.best_cov
+    err = float(np.sqrt(cov * (1 - cov) / max(F2.shape[0], 1)))
+    n_samples = int(np.sum(best_plan.k_ranges[:, 1] - best_plan.k_ranges[:, 0] + 1))
+    message = (
+        f"{search.tried} directions tried; coverage {cov:.3f} ± {err:.3f} of the feasible region "
+        f"with {n_lines} lines, {n_samples} samples, spacing {best_plan.spacing:.4g}"
+    )
+    return PlanResult(best_plan, cov, err, n_samples, message)
+
+
 def plan_lines(
     lower: Any,
     upper: Any,
@@ -350,81 +462,22 @@ def plan_lines(
     SurrogateError
         Bad bounds, d not in {2, 3, 4}, too few lines, or a feasible region the probes (almost) never hit.
     """
-    lo = np.asarray(lower, dtype=float).reshape(-1)
-    hi = np.asarray(upper, dtype=float).reshape(-1)
-    if lo.shape != hi.shape or lo.size not in (2, 3, 4):
-        raise SurrogateError(f"lower and upper must be vectors of length 2 to 4, got {lo.shape} and {hi.shape}")
-    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi)) and np.all(hi > lo)):
-        raise SurrogateError(f"need finite bounds with upper > lower, got lower={lo.tolist()}, upper={hi.tolist()}")
-    dim = lo.size
-    if layout not in LAYOUTS:
-        raise SurrogateError(f"layout must be one of {', '.join(LAYOUTS)}, got {layout!r}")
-    if layout == "boundary" and dim > 3:
-        raise SurrogateError(f"layout 'boundary' places nodes on a polygon (d <= 3); use 'fekete' for d = {dim}")
-    if int(n_lines) < dim:
-        raise SurrogateError(f"n_lines must be >= d = {dim} for the hull to have volume, got {n_lines}")
-    if spacing is not None and not (np.isfinite(spacing) and spacing > 0):
-        raise SurrogateError(f"spacing must be a positive length, got {spacing!r}")
-    if int(samples_per_line) < _MIN_RUN:
-        raise SurrogateError(f"samples_per_line must be >= {_MIN_RUN}, got {samples_per_line}")
-    if not _MIN_RUN <= int(min_samples) <= int(samples_per_line):
-        raise SurrogateError(
-            f"min_samples must be between {_MIN_RUN} and samples_per_line = {samples_per_line}, got {min_samples}"
-        )
+    lo, hi = _checked_box(lower, upper, n_lines, spacing, samples_per_line, min_samples, layout)
     rng = np.random.default_rng(seed)
-    F = _probe(lo, hi, feasible, int(n_probe), rng)
-    if F.shape[0] < 10 * (dim + 1):
-        raise SurrogateError(
-            f"only {F.shape[0]} of {n_probe} probe points are feasible; enlarge n_probe or check the bounds"
-        )
+    F = _ranking_probes(lo, hi, feasible, n_probe, rng)
+    cands = _candidate_directions(F, lo, hi, int(n_random), directions, rng)
     # Ranking candidates needs only a few thousand points (standard error ~0.01); the full set is for reporting.
-    F_rank = F[:_RANK_POINTS]
-    # Work in box-normalised units so "principal axes" and "random directions" do not depend on the units.
-    width = hi - lo
-    Fn = (F - lo) / width
-    _, _, vt = np.linalg.svd(Fn - Fn.mean(axis=0), full_matrices=False)
-    cands = [v * width for v in vt] + list(np.eye(dim))
-    rand = rng.standard_normal((int(n_random), dim))
-    cands += [v * width for v in rand]
-    if directions is not None:
-        cands = [np.asarray(v, dtype=float).reshape(-1) for v in directions]
-        if any(v.shape != (dim,) or not np.linalg.norm(v) > 0 for v in cands):
-            raise SurrogateError(f"directions must be non-zero vectors of length {dim}")
-        n_refine = 0
-    cands = [v / np.linalg.norm(v) for v in cands]
-
     runs_on = feasible if sampleable is None else sampleable
+    # Lines that may run past the feasible region let the boundary layout put its nodes on (or beyond) its edge.
     shrinks = _SHRINKS if sampleable is None else (1.05, 1.0, *_SHRINKS)
-    best_cov, best_plan, tried = 0.0, None, 0
+    search = _DirectionSearch(F[:_RANK_POINTS], spacing, samples_per_line, runs_on, int(n_lines), int(min_samples),
+                              shrinks, layout, rng)
     for u in cands:
-        cov, plan = _evaluate(u, spacing, samples_per_line, F_rank, runs_on, int(n_lines), int(min_samples), shrinks,
-                              layout, rng)
-        tried += 1
-        if plan is not None and cov > best_cov:
-            best_cov, best_plan = cov, plan
-    if best_plan is None:
+        search.try_direction(u)
+    if search.best_plan is None:
         raise SurrogateError(
             f"no direction gave {n_lines} lines with >= {min_samples} feasible samples each; "
             "reduce min_samples or the spacing"
         )
-    for angle in (0.15, 0.05):
-        for _ in range(int(n_refine) // 2):
-            u0 = best_plan.direction / best_plan.spacing
-            u = u0 + angle * rng.standard_normal(dim)
-            u /= np.linalg.norm(u)
-            cov, plan = _evaluate(
-                u, spacing, samples_per_line, F_rank, runs_on, int(n_lines), int(min_samples), shrinks, layout, rng
-            )
-            tried += 1
-            if plan is not None and cov > best_cov:
-                best_cov, best_plan = cov, plan
-
-    F2 = _probe(lo, hi, feasible, int(n_probe), rng)
-    cov = coverage(best_plan, F2) if F2.shape[0] else best_cov
-    err = float(np.sqrt(cov * (1 - cov) / max(F2.shape[0], 1)))
-    n_samples = int(np.sum(best_plan.k_ranges[:, 1] - best_plan.k_ranges[:, 0] + 1))
-    message = (
-        f"{tried} directions tried; coverage {cov:.3f} ± {err:.3f} of the feasible region "
-        f"with {n_lines} lines, {n_samples} samples, spacing {best_plan.spacing:.4g}"
-    )
-    return PlanResult(best_plan, cov, err, n_samples, message)
+    search.refine(0 if directions is not None else int(n_refine))
+    return _rescored(search, lo, hi, feasible, int(n_probe), n_lines, rng)

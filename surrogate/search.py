@@ -374,6 +374,23 @@ class _Polisher:
         return z_best, f_best
 
 
+def _polished(model: SparseExponentialModel, grid: HullGrid, feasible: FeasiblePredicate | None, z0: np.ndarray,
+              f0: float, polish: bool) -> tuple[np.ndarray, float, str, int]:
+    """The grid minimum ``z0`` (plan coordinates) refined on the model, if ``polish``: SLSQP, else local sampling.
+
+    Returns the point, its model value (data units), how it was polished and the model evaluations it took.
+    """
+    if not polish:
+        return z0, f0, "none", 0
+    polisher = _Polisher(model, grid, feasible)
+    res = polisher.slsqp(z0, f0)
+    if res is not None:
+        z, f = res
+        return z, f, "slsqp", polisher.n_eval
+    z, f = polisher.local_sampling(z0, f0)
+    return z, f, "local-sampling", polisher.n_eval
+
+
 def exhaustive_search(
     model: SparseExponentialModel,
     feasible: FeasiblePredicate | None = None,
@@ -423,55 +440,22 @@ def exhaustive_search(
     fun, P, d, n_eval = grid_minimum(model, grid, mask)
     timings["evaluation"] = time.perf_counter() - t
 
-    dim = model.plan.dim
     if not np.isfinite(fun):
         timings["polish"] = 0.0
         timings["total"] = time.perf_counter() - t_start
-        nan = np.full(dim, np.nan)
-        return SearchResult(
-            nan,
-            np.nan,
-            False,
-            f"no feasible point among {grid.n_points} grid points",
-            n_eval,
-            n_feasible,
-            grid.n_points,
-            timings,
-            nan,
-            np.nan,
-            grid.spacing,
-            "none",
-        )
+        nan = np.full(model.plan.dim, np.nan)
+        message = f"no feasible point among {grid.n_points} grid points"
+        return SearchResult(nan, np.nan, False, message, n_eval, n_feasible, grid.n_points, timings, nan, np.nan,
+                            grid.spacing, "none")
 
-    z0 = np.concatenate([P, np.atleast_1d(d)])
     x_grid = model.plan.from_coordinates(P[None, :], np.atleast_1d(d))[0]
     t = time.perf_counter()
-    z, f, how = z0, fun, "none"
-    polisher = _Polisher(model, grid, feasible)
-    if polish:
-        res = polisher.slsqp(z0, fun)
-        if res is not None:
-            (z, f), how = res, "slsqp"
-        else:
-            z, f = polisher.local_sampling(z0, fun)
-            how = "local-sampling"
+    z, f, how, n_polish = _polished(model, grid, feasible, np.concatenate([P, np.atleast_1d(d)]), fun, polish)
     timings["polish"] = time.perf_counter() - t
     x = model.plan.from_coordinates(z[None, :-1], z[-1:])[0]
     timings["total"] = time.perf_counter() - t_start
     message = (
         f"minimum over {n_feasible} feasible of {grid.n_points} grid points (step {grid.spacing:.3g}); polish: {how}"
     )
-    return SearchResult(
-        x,
-        f,
-        True,
-        message,
-        n_eval + polisher.n_eval,
-        n_feasible,
-        grid.n_points,
-        timings,
-        x_grid,
-        fun,
-        grid.spacing,
-        how,
-    )
+    return SearchResult(x, f, True, message, n_eval + n_polish, n_feasible, grid.n_points, timings, x_grid, fun,
+                        grid.spacing, how)

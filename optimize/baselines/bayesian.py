@@ -274,28 +274,74 @@ def minimize_bayesian(
             y = np.where(finite, y, np.max(y[finite]))
             Uarr = np.array(U)
             gp.fit(Uarr, y, rng=rng, n_restarts=2 if n_it % refit_restarts_every == 0 else 0)
-            best = float(np.min(y[finite]))
-            incumbent = Uarr[int(np.argmin(np.where(finite, y, np.inf)))]
-            cand = np.vstack([rng.random((n_candidates, d)),
-                              np.clip(incumbent + 0.05 * rng.standard_normal((n_local_candidates, d)), 0.0, 1.0)])
-            cand = cand[problem.feasible_many(problem.from_unit(cand))]
-            if cand.shape[0] == 0:
-                raise BudgetExhausted("no feasible candidate found for the acquisition")
-            ei = expected_improvement(*gp.predict(cand), best)
-            top = np.argsort(-ei, kind="stable")[:n_polish]
-            pick, pick_ei = cand[top[0]], ei[top[0]]
-
-            def neg_ei(u: np.ndarray, incumbent_value: float = best) -> float:
-                return -float(expected_improvement(*gp.predict(u[None, :]), incumbent_value)[0])
-
-            for j in top:
-                res = minimize(neg_ei, cand[j], method="L-BFGS-B", bounds=[(0.0, 1.0)] * d)
-                if -res.fun > pick_ei and problem.feasible(problem.from_unit(res.x)):
-                    pick, pick_ei = res.x, -res.fun
-            if np.min(np.linalg.norm(Uarr - pick, axis=1)) < 1e-9:
-                # EI has collapsed onto a known design: explore instead of re-simulating (cached) forever.
-                pick = cand[rng.integers(cand.shape[0])]
+            pick = _acquire(problem, gp, Uarr, y, finite, rng, n_candidates=n_candidates,
+                            n_local_candidates=n_local_candidates, n_polish=n_polish)
             observe(np.asarray(pick, dtype=float))
             n_it += 1
     except BudgetExhausted as exc:
         return problem.result(str(exc), nit=n_it)
+
+
+def _acquire(
+    problem: CountedProblem,
+    gp: GaussianProcess,
+    U: np.ndarray,
+    y: np.ndarray,
+    finite: np.ndarray,
+    rng: np.random.Generator,
+    *,
+    n_candidates: int,
+    n_local_candidates: int,
+    n_polish: int,
+) -> np.ndarray:
+    """The next design to simulate: the feasible maximiser of the expected improvement, in the unit cube.
+
+    Parameters
+    ----------
+    problem : CountedProblem
+    gp : GaussianProcess
+        Fitted on ``U`` and ``y``.
+    U : ndarray, shape (n, d)
+        Simulated designs in the unit cube.
+    y : ndarray, shape (n,)
+        Their values, failed simulations (``finite`` False) replaced by the worst finite one.
+    finite : ndarray of bool, shape (n,)
+        Which simulations gave a finite value.
+    rng : numpy.random.Generator
+    n_candidates, n_local_candidates, n_polish : int
+        As in :func:`minimize_bayesian`.
+
+    Returns
+    -------
+    ndarray, shape (d,)
+        The picked feasible candidate, polished when that raised its expected improvement and kept it feasible; a
+        random feasible candidate when the pick coincides with a simulated design.
+
+    Raises
+    ------
+    BudgetExhausted
+        If no candidate is feasible.
+    """
+    d = problem.dim
+    best = float(np.min(y[finite]))
+    incumbent = U[int(np.argmin(np.where(finite, y, np.inf)))]
+    cand = np.vstack([rng.random((n_candidates, d)),
+                      np.clip(incumbent + 0.05 * rng.standard_normal((n_local_candidates, d)), 0.0, 1.0)])
+    cand = cand[problem.feasible_many(problem.from_unit(cand))]
+    if cand.shape[0] == 0:
+        raise BudgetExhausted("no feasible candidate found for the acquisition")
+    ei = expected_improvement(*gp.predict(cand), best)
+    top = np.argsort(-ei, kind="stable")[:n_polish]
+    pick, pick_ei = cand[top[0]], ei[top[0]]
+
+    def neg_ei(u: np.ndarray) -> float:
+        return -float(expected_improvement(*gp.predict(u[None, :]), best)[0])
+
+    for j in top:
+        res = minimize(neg_ei, cand[j], method="L-BFGS-B", bounds=[(0.0, 1.0)] * d)
+        if -res.fun > pick_ei and problem.feasible(problem.from_unit(res.x)):
+            pick, pick_ei = res.x, -res.fun
+    if np.min(np.linalg.norm(U - pick, axis=1)) < 1e-9:
+        # EI has collapsed onto a known design: explore instead of re-simulating (cached) forever.
+        pick = cand[rng.integers(cand.shape[0])]
+    return pick

@@ -15,6 +15,7 @@ chosen solver (rejection for Nelder-Mead, native constraints for SLSQP).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 from scipy.optimize import OptimizeResult
@@ -163,40 +164,70 @@ def minimize_genetic(
     if local not in ("nelder-mead", "slsqp"):
         raise ValueError(f"local must be 'nelder-mead' or 'slsqp', got {local!r}")
     rng = np.random.default_rng(seed)
-    d = problem.dim
 
     def fitness(u: np.ndarray) -> float:
         return problem.penalised(problem.from_unit(u), reject=False, penalty=penalty, power=2.0)
 
-    def tournament(fit: np.ndarray) -> int:
-        picks = rng.choice(fit.size, size=min(tournament_size, fit.size), replace=False)
-        return int(picks[np.argmin(fit[picks])])
-
     n_gen = 0
     try:
         with problem.sub_budget(math.ceil(ga_fraction * problem.remaining)):
-            pop = qmc.LatinHypercube(d, rng=rng).random(pop_size)
+            pop = qmc.LatinHypercube(problem.dim, rng=rng).random(pop_size)
             fit = np.array([fitness(u) for u in pop])
             while True:
-                order = np.argsort(fit, kind="stable")
-                children = [pop[i].copy() for i in order[:n_elite]]
-                child_fit = [fit[i] for i in order[:n_elite]]
-                while len(children) < pop_size:
-                    a, b = pop[tournament(fit)], pop[tournament(fit)]
-                    if rng.random() < p_crossover:
-                        a, b = sbx_crossover(a, b, rng, eta=eta_crossover)
-                    for child in (a, b):
-                        if len(children) < pop_size:
-                            child = polynomial_mutation(child, rng, eta=eta_mutation, probability=p_mutation)
-                            children.append(child)
-                            child_fit.append(fitness(child))
-                pop, fit = np.array(children), np.array(child_fit)
+                pop, fit = _next_generation(pop, fit, fitness, rng, pop_size=pop_size, n_elite=n_elite,
+                                            tournament_size=tournament_size, p_crossover=p_crossover,
+                                            eta_crossover=eta_crossover, eta_mutation=eta_mutation,
+                                            p_mutation=p_mutation)
                 n_gen += 1
     except BudgetExhausted as exc:
         if not exc.local:
             return problem.result(f"GA: {exc}", ngen=n_gen, nfev_ga=problem.nfev)
-    nfev_ga = problem.nfev
+    return _local_phase(problem, rng, local=local, n_local=n_local, n_gen=n_gen)
 
+
+def _next_generation(
+    pop: np.ndarray,
+    fit: np.ndarray,
+    fitness: Callable[[np.ndarray], float],
+    rng: np.random.Generator,
+    *,
+    pop_size: int,
+    n_elite: int,
+    tournament_size: int,
+    p_crossover: float,
+    eta_crossover: float,
+    eta_mutation: float,
+    p_mutation: float | None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The elite plus children bred by tournament selection, SBX and mutation, with their fitness.
+
+    The keywords are those of :func:`minimize_genetic`; ``pop`` (in the unit cube) and ``fit`` are the current
+    generation, ``fitness`` evaluates (and counts) one child.
+    """
+
+    def tournament() -> int:
+        picks = rng.choice(fit.size, size=min(tournament_size, fit.size), replace=False)
+        return int(picks[np.argmin(fit[picks])])
+
+    order = np.argsort(fit, kind="stable")
+    children = [pop[i].copy() for i in order[:n_elite]]
+    child_fit = [fit[i] for i in order[:n_elite]]
+    while len(children) < pop_size:
+        a, b = pop[tournament()], pop[tournament()]
+        if rng.random() < p_crossover:
+            a, b = sbx_crossover(a, b, rng, eta=eta_crossover)
+        for child in (a, b):
+            if len(children) < pop_size:
+                child = polynomial_mutation(child, rng, eta=eta_mutation, probability=p_mutation)
+                children.append(child)
+                child_fit.append(fitness(child))
+    return np.array(children), np.array(child_fit)
+
+
+def _local_phase(problem: CountedProblem, rng: np.random.Generator, *, local: str, n_local: int,
+                 n_gen: int) -> OptimizeResult:
+    """Multistart local solver from the GA's best distinct feasible designs, on the rest of the budget."""
+    nfev_ga = problem.nfev
     starts = problem.best_designs(n_local, min_distance=1e-2)
     if starts.shape[0] == 0:
         return problem.result("GA found no feasible design to start the local solver", ngen=n_gen, nfev_ga=nfev_ga)
@@ -207,5 +238,5 @@ def minimize_genetic(
         else:
             local_nelder_mead(problem, x0)
 
-    n, message = run_multistart(problem, starts, run_local, rng=rng, min_share=d + 2)
+    n, message = run_multistart(problem, starts, run_local, rng=rng, min_share=problem.dim + 2)
     return problem.result(f"GA {n_gen} generations, local: {message}", ngen=n_gen, nfev_ga=nfev_ga)

@@ -81,73 +81,97 @@ def minimize_sce_ua(
     if not 2 <= q <= m:
         raise ValueError(f"need 2 <= subcomplex_size <= complex_size, got q={q}, m={m}")
     s = p * m
-
-    def initial_points() -> np.ndarray | None:
-        found = problem.sample_feasible(s, rng)
-        if found.shape[0] == 0:
-            return None
-        if found.shape[0] < s:
-            # A tiny feasible region: repeat found points rather than give up (repeats are cached, not re-simulated).
-            found = found[rng.integers(found.shape[0], size=s)]
-        return found
-
-    points = initial_points()
+    points = _initial_points(problem, s, rng)
     if points is None:
         return problem.result("no feasible initial point found", nshuffles=0, nrestarts=0)
-
-    def value(x: np.ndarray) -> float:
-        f = problem.evaluate(x)
-        return f if math.isfinite(f) else math.inf
 
     # Trapezoidal selection probabilities of Duan et al.: rank 1 (best) is the most likely.
     ranks = np.arange(1, m + 1)
     weights = 2.0 * (m + 1 - ranks) / (m * (m + 1))
     n_shuffles = n_restarts = 0
     try:
-        values = np.array([value(x) for x in points])
+        values = np.array([_value(problem, x) for x in points])
         while True:
             order = np.argsort(values, kind="stable")
             points, values = points[order], values[order]
             if np.all(np.ptp(points, axis=0) < peps * problem.span):
-                fresh = initial_points()
+                fresh = _initial_points(problem, s, rng)
                 if fresh is None:
                     return problem.result("population converged, no feasible point to restart from",
                                           nshuffles=n_shuffles, nrestarts=n_restarts)
                 fresh[0] = points[0]
-                points, values = fresh, np.array([value(x) for x in fresh])
+                points, values = fresh, np.array([_value(problem, x) for x in fresh])
                 n_restarts += 1
                 continue
             for k in range(p):
                 # Dealing sorted points round-robin gives every complex a share of the whole range.
                 idx = np.arange(k, s, p)
-                cx, cf = points[idx].copy(), values[idx].copy()
-                for _ in range(beta):
-                    chosen = np.sort(rng.choice(m, size=q, replace=False, p=weights))
-                    sub_x, sub_f = cx[chosen], cf[chosen]
-                    for _ in range(alpha):
-                        sub_order = np.argsort(sub_f, kind="stable")
-                        sub_x, sub_f, chosen = sub_x[sub_order], sub_f[sub_order], chosen[sub_order]
-                        worst, worst_f = sub_x[-1], sub_f[-1]
-                        centroid = sub_x[:-1].mean(axis=0)
-                        lo, hi = cx.min(axis=0), cx.max(axis=0)
-                        new_x, new_f = centroid + (centroid - worst), math.inf
-                        if problem.feasible(new_x):
-                            new_f = value(new_x)
-                        else:
-                            z = _random_in_box(problem, lo, hi, rng)
-                            if z is not None:
-                                new_x, new_f = z, value(z)
-                        if not new_f < worst_f:
-                            new_x = 0.5 * (centroid + worst)
-                            new_f = value(new_x) if problem.feasible(new_x) else math.inf
-                            if not new_f < worst_f:
-                                z = _random_in_box(problem, lo, hi, rng)
-                                new_x, new_f = (z, value(z)) if z is not None else (worst, worst_f)
-                        sub_x[-1], sub_f[-1] = new_x, new_f
-                    cx[chosen], cf[chosen] = sub_x, sub_f
-                    complex_order = np.argsort(cf, kind="stable")
-                    cx, cf = cx[complex_order], cf[complex_order]
-                points[idx], values[idx] = cx, cf
+                points[idx], values[idx] = _evolve_complex(problem, points[idx].copy(), values[idx].copy(), rng,
+                                                           weights, q=q, beta=beta, alpha=alpha)
             n_shuffles += 1
     except BudgetExhausted as exc:
         return problem.result(str(exc), nshuffles=n_shuffles, nrestarts=n_restarts)
+
+
+def _initial_points(problem: CountedProblem, s: int, rng: np.random.Generator) -> np.ndarray | None:
+    """``s`` feasible designs (Latin hypercube, rejection), None when none is found."""
+    found = problem.sample_feasible(s, rng)
+    if found.shape[0] == 0:
+        return None
+    if found.shape[0] < s:
+        # A tiny feasible region: repeat found points rather than give up (repeats are cached, not re-simulated).
+        found = found[rng.integers(found.shape[0], size=s)]
+    return found
+
+
+def _value(problem: CountedProblem, x: np.ndarray) -> float:
+    """Simulated objective of a feasible design, a failed simulation ranked last (+inf)."""
+    f = problem.evaluate(x)
+    return f if math.isfinite(f) else math.inf
+
+
+def _evolve_complex(problem: CountedProblem, cx: np.ndarray, cf: np.ndarray, rng: np.random.Generator,
+                    weights: np.ndarray, *, q: int, beta: int, alpha: int) -> tuple[np.ndarray, np.ndarray]:
+    """Competitive complex evolution: ``beta`` steps on one complex (points ``cx``, values ``cf``, sorted).
+
+    Each step draws a sub-complex of ``q`` points with the rank probabilities ``weights`` and replaces its worst
+    point ``alpha`` times by an offspring; returns the complex sorted by value again.
+    """
+    for _ in range(beta):
+        chosen = np.sort(rng.choice(cf.size, size=q, replace=False, p=weights))
+        sub_x, sub_f = cx[chosen], cf[chosen]
+        for _ in range(alpha):
+            sub_order = np.argsort(sub_f, kind="stable")
+            sub_x, sub_f, chosen = sub_x[sub_order], sub_f[sub_order], chosen[sub_order]
+            sub_x[-1], sub_f[-1] = _offspring(problem, sub_x, sub_f, cx, rng)
+        cx[chosen], cf[chosen] = sub_x, sub_f
+        complex_order = np.argsort(cf, kind="stable")
+        cx, cf = cx[complex_order], cf[complex_order]
+    return cx, cf
+
+
+def _offspring(problem: CountedProblem, sub_x: np.ndarray, sub_f: np.ndarray, cx: np.ndarray,
+               rng: np.random.Generator) -> tuple[np.ndarray, float]:
+    """Replacement of the worst point of a sorted sub-complex and its value.
+
+    The reflection through the centroid of the others; if it is not better, the halfway contraction; if neither
+    is, a random point of the complex's enclosing box.  An infeasible trial point is not simulated: a reflection
+    is replaced by a random feasible point of the box, a contraction counts as not better.
+    """
+    worst, worst_f = sub_x[-1], sub_f[-1]
+    centroid = sub_x[:-1].mean(axis=0)
+    lo, hi = cx.min(axis=0), cx.max(axis=0)
+    new_x, new_f = centroid + (centroid - worst), math.inf
+    if problem.feasible(new_x):
+        new_f = _value(problem, new_x)
+    else:
+        z = _random_in_box(problem, lo, hi, rng)
+        if z is not None:
+            new_x, new_f = z, _value(problem, z)
+    if not new_f < worst_f:
+        new_x = 0.5 * (centroid + worst)
+        new_f = _value(problem, new_x) if problem.feasible(new_x) else math.inf
+        if not new_f < worst_f:
+            z = _random_in_box(problem, lo, hi, rng)
+            new_x, new_f = (z, _value(problem, z)) if z is not None else (worst, worst_f)
+    return new_x, new_f

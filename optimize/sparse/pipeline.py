@@ -68,14 +68,14 @@ def run_pipeline(space: ModelSpace, options: SparseOptions, sampler: Sampler,
     """
     problem = space.problem
     used_before = len(sampler.designs)
-    # The lines may use the budget but one simulation, which confirms the candidate.
+    # The lines take at most their share of the budget: the confirmation and the refinement keep the rest.
     stage = build_stage("global", space, options, sampler, options.n_lines, options.samples_per_line,
-                        options.search_points, paper=options.plan == "paper", max_samples=options.budget - 1)
+                        options.search_points, paper=options.plan == "paper", max_samples=options.line_cap())
     log(f"  global model: {stage.n_samples} samples on {stage.plan.n_lines} lines (coverage {stage.coverage:.0%}), "
         f"orders {[int(o) for o in np.ravel(stage.model.orders)]}; candidate {problem.describe(stage.candidate)}, "
         f"model {stage.predicted:.6g}, simulated {stage.simulated:.6g}")
     stages, best = [stage], stage
-    message = f"model and simulation agree within {stage.agreement:.2%} at the candidate"
+    message = f"{_claim_text(stage, problem)}; no refinement"
     remaining = options.budget - (len(sampler.designs) - used_before)
     # Agreement at one point does not prove the candidate optimal, so the refinement always runs when there is
     # budget: first trust-region steps on the model corrected by every simulation (one simulation per step, from the
@@ -119,8 +119,19 @@ def run_pipeline(space: ModelSpace, options: SparseOptions, sampler: Sampler,
                 f"simulation; {problem.describe(tail.candidate)}, simulated {tail.simulated:.6g}")
             if tail.simulated < best.simulated:
                 best = tail
-        message = (f"model and simulation differ by {stage.agreement:.2%} at the model's candidate; model steps and a "
-                   f"local search on the simulator moved it from {stage.simulated:.6g} to {best.simulated:.6g}")
-    elif stage.agreement > options.rel_tol:
-        message = f"model and simulation disagree by {stage.agreement:.2%} at the candidate; no budget left to refine"
+        message = (f"{_claim_text(stage, problem)}; model steps and a local search on the simulator moved it from "
+                   f"{stage.simulated:.6g} to {best.simulated:.6g}")
+    elif options.refine:
+        message = f"{_claim_text(stage, problem)}; no budget left to refine"
     return PipelineResult(stages=stages, best=best, n_simulations=len(sampler.designs) - used_before, message=message)
+
+
+def _claim_text(stage: Stage, problem) -> str:
+    """The model against the simulation at its candidate, absolute (the objective's unit) and as a share of the
+    range of the line samples: a percentage of a value near 0 says nothing (issue 25)."""
+    unit = dict(problem.output_units).get(problem.objective, "")
+    diff = abs(stage.simulated - stage.predicted)
+    share = "" if not np.isfinite(stage.claim_error) else (
+        f", {stage.claim_error:.2%} of the range {stage.sampled_range:.4g} of the line samples")
+    return (f"at the model's candidate the model says {stage.predicted:.6g} and the simulation {stage.simulated:.6g}"
+            f" (differ by {diff:.3g}{(' ' + unit) if unit else ''}{share})")

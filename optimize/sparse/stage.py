@@ -16,7 +16,7 @@ from mechopt.optimize.sparse.space import ModelSpace
 from mechopt.surrogate import LinePlan, SparseExponentialModel, exhaustive_search, plan_lines
 from mechopt.surrogate.errors import SurrogateError
 
-__all__ = ["Stage", "build_stage"]
+__all__ = ["Stage", "build_stage", "planned_designs"]
 
 
 @dataclass
@@ -61,15 +61,35 @@ class Stage:
         """Relative difference between simulation and model at the candidate."""
         return abs(self.simulated - self.predicted) / max(abs(self.simulated), 1e-300)
 
+    @property
+    def sampled_range(self) -> float:
+        """Range (max − min) of the lines' simulated values (objective units; NaN without line samples)."""
+        values = np.concatenate([np.ravel(v) for v in self.line_values]) if self.line_values else np.array([])
+        values = values[np.isfinite(values)]
+        return float(np.ptp(values)) if values.size else float("nan")
+
+    @property
+    def claim_error(self) -> float:
+        """|simulation − model| at the candidate as a fraction of :attr:`sampled_range`: unlike :attr:`agreement`,
+        meaningful for an objective whose best value is near 0."""
+        spread = self.sampled_range
+        return abs(self.simulated - self.predicted) / spread if spread > 0 else float("nan")
+
     def summary(self) -> dict:
         """JSON-able summary."""
         return {
             "name": self.name, "coverage": self.coverage, "n_lines": self.plan.n_lines, "n_samples": self.n_samples,
             "orders": [int(o) for o in np.ravel(self.model.orders)], "direction_u": self.plan.direction.tolist(),
             "candidate": self.candidate.tolist(), "predicted": self.predicted, "simulated": self.simulated,
-            "relative_disagreement": self.agreement, "fit_time_s": self.fit_time_s,
+            "relative_disagreement": self.agreement, "claim_error_of_range": _or_none(self.claim_error),
+            "sampled_range": _or_none(self.sampled_range), "fit_time_s": self.fit_time_s,
             "search_time_s": self.search_time_s,
         }
+
+
+def _or_none(value: float) -> float | None:
+    # None, not NaN, for what could not be measured: result.json stays valid JSON.
+    return float(value) if np.isfinite(value) else None
 
 
 def paper_plan(space: ModelSpace, options: SparseOptions) -> tuple[LinePlan, float]:
@@ -112,6 +132,19 @@ def plan_stage(space: ModelSpace, options: SparseOptions, n_lines: int, samples_
     raise error
 
 
+def planned_designs(space: ModelSpace, options: SparseOptions, n_lines: int, samples_per_line: int,
+                    paper: bool = False, max_samples: int | None = None) -> tuple[LinePlan, float, list[np.ndarray]]:
+    """The lines of a model, their hull's coverage and every line's designs (k, d), before any simulation.
+
+    What :func:`build_stage` simulates, exactly: the plan before a run counts these (and finds them in the store).
+    """
+    plan, cov = plan_stage(space, options, n_lines, samples_per_line, paper)
+    if max_samples is not None:
+        plan = trim_plan(plan, max_samples)
+    all_u = [plan.points(i, np.arange(k0, k1 + 1)) for i, (k0, k1) in enumerate(plan.k_ranges)]
+    return plan, cov, [space.from_u(u) for u in all_u]
+
+
 def build_stage(name: str, space: ModelSpace, options: SparseOptions, sampler: Sampler, n_lines: int,
                 samples_per_line: int, search_points: int, paper: bool = False,
                 max_samples: int | None = None, max_order: int | None = None) -> Stage:
@@ -119,14 +152,10 @@ def build_stage(name: str, space: ModelSpace, options: SparseOptions, sampler: S
 
     ``max_samples`` caps the lines' samples so that a budget is never exceeded.
     """
-    plan, cov = plan_stage(space, options, n_lines, samples_per_line, paper)
-    if max_samples is not None:
-        plan = trim_plan(plan, max_samples)
+    plan, cov, all_designs = planned_designs(space, options, n_lines, samples_per_line, paper, max_samples)
     fit = options.fit or space.problem.fit
-    all_u = [plan.points(i, np.arange(k0, k1 + 1)) for i, (k0, k1) in enumerate(plan.k_ranges)]
-    all_designs = [space.from_u(u) for u in all_u]
     values = sampler(np.vstack(all_designs), desc=f"{name}: {plan.n_lines} lines")
-    line_designs, line_values, samples, k_ranges = [], [], [], []
+    line_designs, line_values, samples, k_ranges, kept = [], [], [], [], []
     start = 0
     for i, designs in enumerate(all_designs):
         v = values[start : start + len(designs)]
@@ -134,22 +163,34 @@ def build_stage(name: str, space: ModelSpace, options: SparseOptions, sampler: S
         ks = np.arange(plan.k_ranges[i][0], plan.k_ranges[i][1] + 1)
         run = longest_finite_run(v)  # a failed simulation splits a line: fit its longest clean stretch
         if run.size < 2:
-            raise MechoptError(f"line {i + 1} of the {name} model has fewer than 2 successful simulations in a row; "
-                               "see the failures in the store")
+            continue  # a line through a region where the simulator fails: the blend goes on without it
         ks, v, designs = ks[run], v[run], designs[run]
         samples.append((ks, v * v if fit == "square" else v))
         k_ranges.append([int(ks[0]), int(ks[-1])])
         line_designs.append(designs)
         line_values.append(v)
-    plan = plan.with_k_ranges(np.array(k_ranges))
+        kept.append(i)
+    dropped = plan.n_lines - len(kept)
+    if len(kept) < 2:
+        raise MechoptError(f"only {len(kept)} of the {plan.n_lines} lines of the {name} model have 2 successful "
+                           "simulations in a row; see the failures in the store")
+    plan = LinePlan(plan.direction, plan.origin, plan.offsets[kept], k_ranges=np.array(k_ranges))
     t0 = time.perf_counter()
     sparse = SparseExponentialModel(max_order=options.max_order if max_order is None else max_order)
-    model = ObjectiveModel(sparse.fit(plan, samples), fit, space.order, space.problem.names)
-    fit_time = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    # Minimising the square of a non-negative objective is minimising the objective: search the underlying model.
-    found = exhaustive_search(model.model, feasible=space.screen_u, n_points=search_points)
-    search_time = time.perf_counter() - t0
+    try:
+        model = ObjectiveModel(sparse.fit(plan, samples), fit, space.order, space.problem.names)
+        fit_time = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        # Minimising the square of a non-negative objective is minimising the objective: search the underlying
+        # model.
+        found = exhaustive_search(model.model, feasible=space.screen_u, n_points=search_points)
+        search_time = time.perf_counter() - t0
+    except SurrogateError as exc:
+        if not dropped:
+            raise
+        raise MechoptError(f"{dropped} of the {plan.n_lines + dropped} lines of the {name} model failed to simulate "
+                           f"and the others cannot make a model ({exc}); see the failures in the store, or give "
+                           "more lines (--lines-fit, options={'n_lines': N})") from None
     candidate = pull_into_feasible(space, space.from_u(found.x), np.vstack(line_designs))
     predicted = float(model.predict(candidate)[0])
     simulated = float(sampler(candidate[None, :], desc=f"{name}: confirm")[0])

@@ -8,7 +8,8 @@ measures, each a fraction of a range so that one threshold serves every study:
 * leave-one-line-out: each line's samples predicted by the blend of the other lines (:mod:`surrogate.line_error`),
   RMS over the line, relative to the range of all line samples (of the fitted quantity: T_RMS² where the study fits
   the square);
-* the model's claim: model against simulation at the model's own candidate, relative to the simulated value;
+* the model's claim: model against simulation at the model's own candidate, relative to the range of the line
+  samples (relative to the simulated value it would mean nothing for an objective whose best value is near 0);
 * held-out validation, when it ran: RMSE relative to the range of the held-out values.
 """
 
@@ -24,10 +25,15 @@ from mechopt.optimize.sparse.validate import Validation
 from mechopt.surrogate import SurrogateError
 from mechopt.surrogate.line_error import leave_one_line_out
 
-__all__ = ["RESOLVED", "study_trust"]
+__all__ = ["REMEDY", "RESOLVED", "study_trust"]
 
 #: Largest relative error (of each measure) at which the model is said to resolve the landscape.
 RESOLVED = 0.05
+
+#: What a user can do about an unresolved landscape, named as the command-line flag and the API argument.
+REMEDY = ("Remedies: more lines (mechopt study --lines-fit N, or mechopt.minimize(options={'n_lines': N}) with a "
+          "budget that pays for them), or the global method (mechopt study --method sparse-global, or "
+          "mechopt.minimize(method='sparse-global'))")
 
 
 def study_trust(global_stage: Stage, final: Stage, validation: Validation | None = None) -> dict[str, Any]:
@@ -45,8 +51,8 @@ def study_trust(global_stage: Stage, final: Stage, validation: Validation | None
     Returns
     -------
     dict
-        ``lolo_median``, ``lolo_max`` (fractions of the sampled range), ``claim_error`` (fraction of the simulated
-        value), ``heldout_error`` (fraction of the held-out range; each None when it could not be measured, e.g.
+        ``lolo_median``, ``lolo_max`` (fractions of the sampled range), ``claim_error`` (fraction of the line samples'
+        range), ``heldout_error`` (fraction of the held-out range; each None when it could not be measured, e.g.
         without validation), ``resolved`` (bool),
         ``source`` (the answering stage) and ``verdict`` (one sentence).
     """
@@ -59,14 +65,14 @@ def study_trust(global_stage: Stage, final: Stage, validation: Validation | None
         lolo_median, lolo_max = lolo.median, lolo.max
     except SurrogateError:
         pass  # fewer than 3 lines, or lines cut by failed samples: no estimate, said as NaN
-    claim = global_stage.agreement
+    claim = global_stage.claim_error
     heldout = math.nan
     if validation is not None and math.isfinite(validation.rmse_pct_of_range):
         heldout = validation.rmse_pct_of_range / 100.0
     measured = [m for m in (lolo_median, claim, heldout) if math.isfinite(m)]
     resolved = bool(measured) and max(measured) <= RESOLVED
     parts = [f"leave-one-line-out error {_pct(lolo_median)} of the sampled range",
-             f"its claim at its candidate off by {_pct(claim)}"]
+             f"its claim at its candidate off by {_pct(claim)} of that range"]
     if math.isfinite(heldout):
         parts.append(f"held-out error {_pct(heldout)} of the held-out range")
     where = f"the answer is the best simulated design, from the stage '{final.name}'"
@@ -74,8 +80,7 @@ def study_trust(global_stage: Stage, final: Stage, validation: Validation | None
         verdict = f"the global model resolves the landscape ({', '.join(parts)}); {where}"
     else:
         verdict = (f"the global model does not resolve the landscape at this line spacing ({', '.join(parts)}): it "
-                   f"only pointed at a basin, and another basin may be lower; {where}. More lines, or "
-                   "method='sparse-global', are the remedy")
+                   f"only pointed at a basin, and another basin may be lower; {where}. {REMEDY}")
     # None, not NaN, for a measure that could not be taken: result.json stays valid JSON.
     return {"lolo_median": _or_none(lolo_median), "lolo_max": _or_none(lolo_max), "claim_error": _or_none(claim),
             "heldout_error": _or_none(heldout), "resolved": resolved, "source": final.name, "verdict": verdict}

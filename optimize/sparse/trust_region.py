@@ -87,89 +87,133 @@ def trust_region_steps(model: Callable[[np.ndarray], np.ndarray], simulate: Call
     """
     box = np.asarray(box, dtype=float)
     lower, span = box[:, 0], box[:, 1] - box[:, 0]
-    d = lower.size
     keep = np.isfinite(q)
     X = np.asarray(X, dtype=float)[keep]
-    U = (X - lower) / span
     q = np.asarray(q, dtype=float)[keep]
     # Samples outside the region (lines run past it) inform the correction; only a feasible one may be the start.
     inside = np.asarray(feasible(X), dtype=bool)
     if not inside.any():
-        return TrustRegionResult(x=np.full(d, np.nan), value=float("nan"), n_steps=0, radius=0.0)
+        return TrustRegionResult(x=np.full(lower.size, np.nan), value=float("nan"), n_steps=0, radius=0.0)
     best = int(np.flatnonzero(inside)[np.argmin(q[inside])])
-    u_best, q_best = U[best].copy(), float(q[best])
-    radius, steps, creeping = RADIUS_START, 0, 0
-    rng = np.random.default_rng(seed)
-    sobol = qmc.Sobol(d, seed=rng)
-    scale = max(float(np.ptp(q)), abs(q_best), 1e-300)
+    steps = _Steps(model, simulate, feasible, lower, span, (X - lower) / span, q, best, seed, margins)
+    while steps.n_steps < budget and steps.radius >= RADIUS_MIN:
+        if not steps.step(budget):
+            break
+    return TrustRegionResult(x=lower + steps.u_best * span, value=steps.q_best, n_steps=steps.n_steps,
+                             radius=steps.radius)
 
-    def base(Uc: np.ndarray) -> np.ndarray:
-        return np.asarray(model(lower + np.atleast_2d(Uc) * span), dtype=float)
 
-    while steps < budget and radius >= RADIUS_MIN:
-        residual = (q - base(U)) / scale
-        # Thin-plate splines with a linear tail interpolate the residuals exactly and stay mild between samples; a
-        # tiny smoothing keeps the system solvable when two designs nearly coincide.
-        correction = residual_model(U, residual)
+class _Steps:
+    """The state of the steps, in the unit cube of the box: every simulated design, the best one and the region.
 
-        def corrected(Uc: np.ndarray, correction=correction) -> np.ndarray:
+    Parameters
+    ----------
+    model, simulate, feasible, margins :
+        As in :func:`trust_region_steps`.
+    lower, span : (d,) ndarrays
+        Lower bounds and widths of the box (design units).
+    U, q : (n, d) and (n,) ndarrays
+        The designs simulated so far (unit cube) and their finite fitted quantities.
+    best : int
+        Row of the feasible design to start from.
+    seed : int
+        Seed of the candidate points inside each region.
+    """
+
+    def __init__(self, model: Callable[[np.ndarray], np.ndarray], simulate: Callable[[np.ndarray], float],
+                 feasible: Callable[[np.ndarray], np.ndarray], lower: np.ndarray, span: np.ndarray, U: np.ndarray,
+                 q: np.ndarray, best: int, seed: int, margins: Callable[[np.ndarray], np.ndarray] | None) -> None:
+        self.model, self.simulate, self.feasible, self.margins = model, simulate, feasible, margins
+        self.lower, self.span = lower, span
+        self.U, self.q = U, q
+        self.u_best, self.q_best = U[best].copy(), float(q[best])
+        self.radius, self.n_steps, self.creeping = RADIUS_START, 0, 0
+        self.sobol = qmc.Sobol(lower.size, seed=np.random.default_rng(seed))
+        self.scale = max(float(np.ptp(q)), abs(self.q_best), 1e-300)
+
+    def base(self, Uc: np.ndarray) -> np.ndarray:
+        """The line model at unit-cube designs (fitted units)."""
+        return np.asarray(self.model(self.lower + np.atleast_2d(Uc) * self.span), dtype=float)
+
+    def corrected_model(self) -> Callable[[np.ndarray], np.ndarray]:
+        """The line model plus the interpolant of its residuals at every simulation so far, divided by the scale."""
+        correction = residual_model(self.U, (self.q - self.base(self.U)) / self.scale)
+
+        def corrected(Uc: np.ndarray) -> np.ndarray:
             Uc = np.atleast_2d(Uc)
-            return base(Uc) / scale + correction(Uc)
+            return self.base(Uc) / self.scale + correction(Uc)
 
-        lo, hi = np.maximum(u_best - radius, 0.0), np.minimum(u_best + radius, 1.0)
-        cloud = lo + sobol.random(512) * (hi - lo)
-        cloud = np.vstack([u_best, cloud[np.asarray(feasible(lower + cloud * span), dtype=bool)]])
+        return corrected
+
+    def proposal(self, corrected: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+        """The best feasible local minimum of the corrected model in the region around the best design."""
+        lo, hi = np.maximum(self.u_best - self.radius, 0.0), np.minimum(self.u_best + self.radius, 1.0)
+        cloud = lo + self.sobol.random(512) * (hi - lo)
+        cloud = np.vstack([self.u_best, cloud[np.asarray(self.feasible(self.lower + cloud * self.span), dtype=bool)]])
         values = corrected(cloud)
-        u_new = _polish(corrected, cloud[np.argsort(values)[:3]], lo, hi, lower, span, margins, feasible)
+        return _polish(corrected, cloud[np.argsort(values)[:3]], lo, hi, self.lower, self.span, self.margins,
+                       self.feasible)
+
+    def run(self, u: np.ndarray) -> float:
+        """Simulate the unit-cube design u (counted); a finite value joins the simulated designs."""
+        value = float(self.simulate(self.lower + u * self.span))
+        self.n_steps += 1
+        if np.isfinite(value):
+            self.U, self.q = np.vstack([self.U, u]), np.append(self.q, value)
+        return value
+
+    def step(self, budget: int) -> bool:
+        """One step: propose, simulate, resize the region.  False when the steps should end."""
+        corrected = self.corrected_model()
+        u_new = self.proposal(corrected)
         predicted = float(corrected(u_new)[0])
-        here = float(corrected(u_best)[0])
-        if np.max(np.abs(u_new - u_best) / np.maximum(radius, 1e-12)) < 1e-3 or here - predicted <= 1e-12:
+        here = float(corrected(self.u_best)[0])
+        if np.max(np.abs(u_new - self.u_best) / np.maximum(self.radius, 1e-12)) < 1e-3 or here - predicted <= 1e-12:
             # The corrected model sees no decrease in this region: look closer.
-            radius *= 0.5
-            continue
-        if np.min(np.max(np.abs(U - u_new), axis=1)) < 1e-7:
-            radius *= 0.5
-            continue
-        value = float(simulate(lower + u_new * span))
-        steps += 1
+            self.radius *= 0.5
+            return True
+        if np.min(np.max(np.abs(self.U - u_new), axis=1)) < 1e-7:
+            self.radius *= 0.5
+            return True
+        value = self.run(u_new)
         if not np.isfinite(value):
-            radius *= 0.5
-            continue
-        U, q = np.vstack([U, u_new]), np.append(q, value)
-        ratio = (q_best - value) / max((here - predicted) * scale, 1e-300)
-        on_edge = np.any(np.abs(u_new - u_best) > 0.9 * radius)
-        if value < q_best:
-            step = u_new - u_best
-            creeping = creeping + 1 if np.max(np.abs(step)) < CREEP else 0
-            u_best, q_best = u_new, value
-            if creeping >= 2:
-                # Creeping along a valley: the last step points down it, so run down that line with doubling steps
-                # while the simulations keep decreasing (a straight valley is crossed in a few simulations).
-                creeping = 0
-                factor, moved = 2.0, False
-                while steps < budget:
-                    u_try = u_best + factor * step
-                    if np.any(u_try < 0.0) or np.any(u_try > 1.0) or not feasible(lower + u_try[None, :] * span)[0]:
-                        break
-                    value = float(simulate(lower + u_try * span))
-                    steps += 1
-                    if not np.isfinite(value):
-                        break
-                    U, q = np.vstack([U, u_try]), np.append(q, value)
-                    if value >= q_best:
-                        break
-                    u_best, q_best, moved = u_try, value, True
-                    factor *= 2.0
-                if not moved:
-                    break
-                continue
-            if ratio > GROW and on_edge:
-                radius = min(2.0 * radius, 0.5)
-            elif ratio < SHRINK:
-                radius *= 0.5
-        else:
-            radius *= 0.5
-    return TrustRegionResult(x=lower + u_best * span, value=q_best, n_steps=steps, radius=radius)
+            self.radius *= 0.5
+            return True
+        ratio = (self.q_best - value) / max((here - predicted) * self.scale, 1e-300)
+        on_edge = np.any(np.abs(u_new - self.u_best) > 0.9 * self.radius)
+        if value >= self.q_best:
+            self.radius *= 0.5
+            return True
+        step = u_new - self.u_best
+        self.creeping = self.creeping + 1 if np.max(np.abs(step)) < CREEP else 0
+        self.u_best, self.q_best = u_new, value
+        if self.creeping >= 2:
+            self.creeping = 0
+            return self.run_down_valley(step, budget)
+        if ratio > GROW and on_edge:
+            self.radius = min(2.0 * self.radius, 0.5)
+        elif ratio < SHRINK:
+            self.radius *= 0.5
+        return True
+
+    def run_down_valley(self, step: np.ndarray, budget: int) -> bool:
+        """Doubling steps along ``step`` from the best design while the simulations keep decreasing.
+
+        Creeping along a valley, the last step points down it, so a straight valley is crossed in a few
+        simulations.  Returns whether the best design moved (if not, the steps have nothing left to try).
+        """
+        factor, moved = 2.0, False
+        while self.n_steps < budget:
+            u_try = self.u_best + factor * step
+            if (np.any(u_try < 0.0) or np.any(u_try > 1.0)
+                    or not self.feasible(self.lower + u_try[None, :] * self.span)[0]):
+                break
+            value = self.run(u_try)
+            if not np.isfinite(value) or value >= self.q_best:
+                break
+            self.u_best, self.q_best, moved = u_try, value, True
+            factor *= 2.0
+        return moved
 
 
 def residual_model(U: np.ndarray, residual: np.ndarray,

@@ -49,11 +49,14 @@ class Validation:
         """RMSE as a percentage of the held-out values' range."""
         return 100 * self.rmse / self.spread if self.n_points and self.spread > 0 else float("nan")
 
-    def relative_text(self) -> str:
-        """The RMSE relative to the scale that means something: f_min, or the range when f_min is (near) 0."""
-        if self.f_min and abs(self.f_min) > 1e-3 * self.spread:
-            return f"{self.rmse_pct:.2f} % of the best simulated value {self.f_min:.4g}"
-        return f"{self.rmse_pct_of_range:.2f} % of the held-out values' range {self.spread:.4g}"
+    def relative_text(self, unit: str = "") -> str:
+        """The RMSE as a share of the held-out values' range, with that range in the objective's ``unit``.
+
+        Always the range, never the best value: a percentage of a value near 0 says nothing (issue 25 read
+        "RMSE 33.21 % of the best simulated value −0.05777").
+        """
+        unit = f" {unit}" if unit else ""
+        return f"{self.rmse_pct_of_range:.2f} % of the held-out values' range {self.spread:.4g}{unit}"
 
     def summary(self) -> dict:
         """JSON-able summary (lines with their points)."""

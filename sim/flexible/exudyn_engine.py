@@ -68,119 +68,138 @@ def simulate_exudyn(p: FlexibleSliderCrank, steps_per_sample: int = 8, newton_to
     Response
     """
     import exudyn as exu  # lazily: importing Exudyn costs ~1 s and only this engine needs it
-    from exudyn.itemInterface import (
-        CoordinateConstraint,
-        MarkerBodyPosition,
-        MarkerBodyRigid,
-        MarkerNodeCoordinate,
-        MarkerNodePosition,
-        MassPoint2D,
-        NodePoint2D,
-        NodePoint2DSlope1,
-        NodePointGround,
-        NodeRigidBody2D,
-        ObjectANCFCable2D,
-        ObjectGround,
-        ObjectRigidBody2D,
-        RevoluteJoint2D,
-        SensorNode,
-    )
+    import exudyn.itemInterface as items
 
     if p.n_elements % 2:
         raise InputError(f"n_elements = {p.n_elements}: the Exudyn engine needs an even number (a mid-span node)")
     start = time.perf_counter()
+    sc = exu.SystemContainer()  # owns the system: it must outlive every call on ``mbs``
+    mbs = sc.AddSystem()
+    ground = mbs.AddObject(items.ObjectGround())
+    n_ground = mbs.AddNode(items.NodePointGround())
+    m_ground_coord = mbs.AddMarker(items.MarkerNodeCoordinate(nodeNumber=n_ground, coordinate=0))
+    m_crank_tip = _add_crank(mbs, items, p, ground, m_ground_coord)
+    s_nodes = np.linspace(0.0, p.l3, p.n_elements + 1)
+    nodes, u_end = _add_rod(mbs, items, p, s_nodes, m_crank_tip)
+    n_slider = _add_slider(mbs, items, p, nodes[-1], u_end, m_ground_coord)
+    sensors = _add_sensors(mbs, items, exu.OutputVariableType, n_slider, nodes)
+    mbs.Assemble()
+    mbs.SolveDynamic(_solver_settings(exu, p, steps_per_sample, newton_tolerance))
+    return _response(mbs, p, sensors, s_nodes, start)
+
+
+def _add_crank(mbs, items, p: FlexibleSliderCrank, ground: int, m_ground_coord: int) -> int:
+    """The crank pinned at O and turned at the constant rate ω; returns the marker of its tip A."""
+    r, w = p.l2, p.omega
+    # its inertia is irrelevant (the rate is prescribed), a small one keeps the mass matrix regular
+    crank_mass = 1e-3
+    n_crank = mbs.AddNode(items.NodeRigidBody2D(referenceCoordinates=[0.0, 0.0, 0.0],
+                                                initialVelocities=[0.0, 0.0, w]))
+    o_crank = mbs.AddObject(items.ObjectRigidBody2D(mass=crank_mass, inertia=crank_mass * r * r / 3.0,
+                                                    nodeNumber=n_crank))
+    m_o_ground = mbs.AddMarker(items.MarkerBodyRigid(bodyNumber=ground, localPosition=[0.0, 0.0, 0.0]))
+    m_o_crank = mbs.AddMarker(items.MarkerBodyRigid(bodyNumber=o_crank, localPosition=[0.0, 0.0, 0.0]))
+    mbs.AddObject(items.RevoluteJoint2D(markerNumbers=[m_o_ground, m_o_crank]))
+    m_crank_angle = mbs.AddMarker(items.MarkerNodeCoordinate(nodeNumber=n_crank, coordinate=2))
+    mbs.AddObject(items.CoordinateConstraint(markerNumbers=[m_ground_coord, m_crank_angle], offset=w,
+                                             velocityLevel=True))
+    return mbs.AddMarker(items.MarkerBodyRigid(bodyNumber=o_crank, localPosition=[r, 0.0, 0.0]))
+
+
+def _add_rod(mbs, items, p: FlexibleSliderCrank, s_nodes: np.ndarray, m_crank_tip: int) -> tuple[list[int], float]:
+    """The rod's cable elements, in their state at θ2 = 0, pinned to the crank tip.
+
+    Returns the rod's node numbers (A to B) and the axial displacement (m) of its last node.
+    """
     r, L, w = p.l2, p.l3, p.omega
     n = p.n_elements
-    sc = exu.SystemContainer()
-    mbs = sc.AddSystem()
-    ground = mbs.AddObject(ObjectGround())
-    n_ground = mbs.AddNode(NodePointGround())
-    m_ground_coord = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=n_ground, coordinate=0))
-
-    # crank: its inertia is irrelevant (the rate is prescribed), a small one keeps the mass matrix regular
-    crank_mass = 1e-3
-    n_crank = mbs.AddNode(NodeRigidBody2D(referenceCoordinates=[0.0, 0.0, 0.0], initialVelocities=[0.0, 0.0, w]))
-    o_crank = mbs.AddObject(ObjectRigidBody2D(mass=crank_mass, inertia=crank_mass * r * r / 3.0,
-                                              nodeNumber=n_crank))
-    m_o_ground = mbs.AddMarker(MarkerBodyRigid(bodyNumber=ground, localPosition=[0.0, 0.0, 0.0]))
-    m_o_crank = mbs.AddMarker(MarkerBodyRigid(bodyNumber=o_crank, localPosition=[0.0, 0.0, 0.0]))
-    mbs.AddObject(RevoluteJoint2D(markerNumbers=[m_o_ground, m_o_crank]))
-    m_crank_angle = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=n_crank, coordinate=2))
-    mbs.AddObject(CoordinateConstraint(markerNumbers=[m_ground_coord, m_crank_angle], offset=w, velocityLevel=True))
-    m_crank_tip = mbs.AddMarker(MarkerBodyRigid(bodyNumber=o_crank, localPosition=[r, 0.0, 0.0]))
-
     # rod along +x from A = (r, 0) at θ2 = 0; rigid velocity field v = (0, r ω + φ̇ s), slope rate (0, φ̇)
     m0 = rigid_motion(r, L, w, np.array([0.0]))
     phi_d = float(m0.phi_d[0])
-    s_nodes = np.linspace(0.0, L, n + 1)
     u_axial = _initial_axial_strain(p, s_nodes)
     strain = _tension_slope(p, s_nodes)
     nodes = []
     for s, u, eps in zip(s_nodes, u_axial, strain, strict=True):
-        nodes.append(mbs.AddNode(NodePoint2DSlope1(
+        nodes.append(mbs.AddNode(items.NodePoint2DSlope1(
             referenceCoordinates=[r + s, 0.0, 1.0, 0.0],
             initialCoordinates=[u, 0.0, eps, 0.0],
             initialVelocities=[0.0, r * w + phi_d * s, 0.0, phi_d])))
     ea, ei = p.E * p.area, p.E * p.second_moment
     for e in range(n):
-        mbs.AddObject(ObjectANCFCable2D(
+        mbs.AddObject(items.ObjectANCFCable2D(
             length=L / n, massPerLength=p.rho * p.area, bendingStiffness=ei, axialStiffness=ea,
             bendingDamping=p.beta * ei, axialDamping=p.beta * ea,
             nodeNumbers=[nodes[e], nodes[e + 1]]))
-    mbs.AddObject(RevoluteJoint2D(markerNumbers=[m_crank_tip, mbs.AddMarker(MarkerNodePosition(nodeNumber=nodes[0]))]))
+    mbs.AddObject(items.RevoluteJoint2D(
+        markerNumbers=[m_crank_tip, mbs.AddMarker(items.MarkerNodePosition(nodeNumber=nodes[0]))]))
+    return nodes, u_axial[-1]
 
-    # slider: a point mass on the x axis, pinned to the rod's last node
-    n_slider = mbs.AddNode(NodePoint2D(referenceCoordinates=[r + L, 0.0], initialCoordinates=[u_axial[-1], 0.0]))
-    o_slider = mbs.AddObject(MassPoint2D(mass=p.slider_mass, nodeNumber=n_slider))
-    m_slider = mbs.AddMarker(MarkerBodyPosition(bodyNumber=o_slider, localPosition=[0.0, 0.0, 0.0]))
-    mbs.AddObject(RevoluteJoint2D(markerNumbers=[mbs.AddMarker(MarkerNodePosition(nodeNumber=nodes[-1])), m_slider]))
-    m_slider_y = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=n_slider, coordinate=1))
-    mbs.AddObject(CoordinateConstraint(markerNumbers=[m_ground_coord, m_slider_y]))
 
-    out = exu.OutputVariableType
-    sens_v = mbs.AddSensor(SensorNode(nodeNumber=n_slider, storeInternal=True, writeToFile=False,
-                                      outputVariableType=out.Velocity))
-    sens_a = mbs.AddSensor(SensorNode(nodeNumber=n_slider, storeInternal=True, writeToFile=False,
-                                      outputVariableType=out.Acceleration))
-    sens_pos = [mbs.AddSensor(SensorNode(nodeNumber=k, storeInternal=True, writeToFile=False,
-                                         outputVariableType=out.Position)) for k in nodes]
-    mbs.Assemble()
+def _add_slider(mbs, items, p: FlexibleSliderCrank, rod_end: int, u_end: float, m_ground_coord: int) -> int:
+    """The slider, a point mass on the x axis pinned to the rod's last node ``rod_end``; returns its node."""
+    n_slider = mbs.AddNode(items.NodePoint2D(referenceCoordinates=[p.l2 + p.l3, 0.0], initialCoordinates=[u_end, 0.0]))
+    o_slider = mbs.AddObject(items.MassPoint2D(mass=p.slider_mass, nodeNumber=n_slider))
+    m_slider = mbs.AddMarker(items.MarkerBodyPosition(bodyNumber=o_slider, localPosition=[0.0, 0.0, 0.0]))
+    mbs.AddObject(items.RevoluteJoint2D(
+        markerNumbers=[mbs.AddMarker(items.MarkerNodePosition(nodeNumber=rod_end)), m_slider]))
+    m_slider_y = mbs.AddMarker(items.MarkerNodeCoordinate(nodeNumber=n_slider, coordinate=1))
+    mbs.AddObject(items.CoordinateConstraint(markerNumbers=[m_ground_coord, m_slider_y]))
+    return n_slider
 
-    dt_out = p.t_end / (p.n_samples - 1)
+
+def _add_sensors(mbs, items, out, n_slider: int, nodes: list[int]) -> tuple[int, int, list[int]]:
+    """In-memory sensors of the slider's velocity and acceleration and of every rod node's position."""
+    sens_v = mbs.AddSensor(items.SensorNode(nodeNumber=n_slider, storeInternal=True, writeToFile=False,
+                                            outputVariableType=out.Velocity))
+    sens_a = mbs.AddSensor(items.SensorNode(nodeNumber=n_slider, storeInternal=True, writeToFile=False,
+                                            outputVariableType=out.Acceleration))
+    sens_pos = [mbs.AddSensor(items.SensorNode(nodeNumber=k, storeInternal=True, writeToFile=False,
+                                               outputVariableType=out.Position)) for k in nodes]
+    return sens_v, sens_a, sens_pos
+
+
+def _solver_settings(exu, p: FlexibleSliderCrank, steps_per_sample: int, newton_tolerance: float):
+    """Generalized-α over [0, t_end], sensors written once per sample, no file and no console output."""
     settings = exu.SimulationSettings()
     settings.timeIntegration.endTime = p.t_end
     settings.timeIntegration.numberOfSteps = steps_per_sample * (p.n_samples - 1)
     settings.timeIntegration.newton.relativeTolerance = newton_tolerance
     settings.timeIntegration.verboseMode = 0
     settings.solution.file.write = False
-    settings.solution.sensors.writePeriod = dt_out
+    settings.solution.sensors.writePeriod = p.t_end / (p.n_samples - 1)
     settings.solution.file.writeInitialValues = True
     settings.show.computationTime = False
     settings.show.statistics = False
-    mbs.SolveDynamic(settings)
+    return settings
 
+
+def _sampled(mbs, sensor: int, p: FlexibleSliderCrank) -> np.ndarray:
+    """A sensor's stored values on the ``n_samples`` sample instants, shape (n_samples, n_values)."""
+    dt_out = p.t_end / (p.n_samples - 1)
+    data = np.asarray(mbs.GetSensorStoredData(sensor))
+    # one row per write period; match rows to the sample instants by time (the first row is t = 0)
+    idx = np.rint(data[:, 0] / dt_out).astype(int)
+    keep = np.zeros(p.n_samples, dtype=bool)
+    values = np.full((p.n_samples, data.shape[1] - 1), np.nan)
+    ok = (idx >= 0) & (idx < p.n_samples) & (np.abs(data[:, 0] - idx * dt_out) < 1e-3 * dt_out)
+    values[idx[ok]] = data[ok, 1:]
+    keep[idx[ok]] = True
+    if not keep.all():
+        raise RuntimeError(f"Exudyn stored {int(keep.sum())} of {p.n_samples} samples")
+    return values
+
+
+def _response(mbs, p: FlexibleSliderCrank, sensors: tuple[int, int, list[int]], s_nodes: np.ndarray,
+              start: float) -> Response:
+    """V, A of the slider and the rod's deflection from its end-node chord, from the solved system's sensors."""
+    sens_v, sens_a, sens_pos = sensors
     t = np.linspace(0.0, p.t_end, p.n_samples)
-
-    def sampled(sensor: int) -> np.ndarray:
-        data = np.asarray(mbs.GetSensorStoredData(sensor))
-        # one row per write period; match rows to the sample instants by time (the first row is t = 0)
-        idx = np.rint(data[:, 0] / dt_out).astype(int)
-        keep = np.zeros(p.n_samples, dtype=bool)
-        values = np.full((p.n_samples, data.shape[1] - 1), np.nan)
-        ok = (idx >= 0) & (idx < p.n_samples) & (np.abs(data[:, 0] - idx * dt_out) < 1e-3 * dt_out)
-        values[idx[ok]] = data[ok, 1:]
-        keep[idx[ok]] = True
-        if not keep.all():
-            raise RuntimeError(f"Exudyn stored {int(keep.sum())} of {p.n_samples} samples")
-        return values
-
-    V = sampled(sens_v)[:, 0]
-    A = sampled(sens_a)[:, 0]
-    P = np.stack([sampled(k)[:, :2] for k in sens_pos], axis=1)  # (n_samples, n + 1, 2)
+    V = _sampled(mbs, sens_v, p)[:, 0]
+    A = _sampled(mbs, sens_a, p)[:, 0]
+    P = np.stack([_sampled(mbs, k, p)[:, :2] for k in sens_pos], axis=1)  # (n_samples, n + 1, 2)
     chord = P[:, -1] - P[:, 0]
     length = np.linalg.norm(chord, axis=1)
     normal = np.stack([-chord[:, 1], chord[:, 0]], axis=1) / length[:, None]
     shape = np.einsum("tkj,tj->tk", P - P[:, :1], normal)
-    return Response(t=t, V=V, A=A, D=shape[:, n // 2], s=s_nodes, shape=shape, engine="exudyn",
+    return Response(t=t, V=V, A=A, D=shape[:, p.n_elements // 2], s=s_nodes, shape=shape, engine="exudyn",
                     seconds=time.perf_counter() - start)
-

@@ -153,44 +153,74 @@ def _run(exudyn_modules, design_m: np.ndarray, mechanism: FourBar, t: np.ndarray
          psi_ref: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Build the multibody system, integrate one cycle on the uniform grid ``t``; return τ, θ, ψ there."""
     exu, items = exudyn_modules
-    oa, ab, bc = (float(v) for v in design_m)
     xc, yc = (v * MM for v in mechanism.pivot_c)
     psi0 = float(psi_ref[0])
     theta0 = float(theta_ref[0])
     theta_mid = 0.5 * (float(np.min(theta_ref)) + float(np.max(theta_ref)))
-    a0 = np.array([oa * np.cos(theta0), oa * np.sin(theta0)])
-    b0 = np.array([xc + bc * np.cos(psi0), yc + bc * np.sin(psi0)])
 
-    sc = exu.SystemContainer()
+    sc = exu.SystemContainer()  # owns the system: it must outlive every call on ``mbs``
     mbs = sc.AddSystem()
     ground = mbs.AddObject(items.ObjectGround(referencePosition=[0.0, 0.0, 0.0]))
     ground_node = mbs.AddNode(items.NodePointGround(referenceCoordinates=[0.0, 0.0, 0.0]))
     ground_coord = mbs.AddMarker(items.MarkerNodeCoordinate(nodeNumber=ground_node, coordinate=0))
+    crank_node, rocker_node = _add_linkage(mbs, items, ground, design_m, mechanism, theta0, psi0)
+    params = _drive_params(design_m, mechanism, theta0, theta_mid)
+    drive = _add_drive_and_load(mbs, items, ground_coord, crank_node, rocker_node, params, mechanism, psi0)
+    sensors = _add_sensors(mbs, exu, items, drive, crank_node, rocker_node)
+    mbs.Assemble()
 
-    def body(position, angle, mass, inertia):
-        node = mbs.AddNode(items.NodeRigidBody2D(referenceCoordinates=[position[0], position[1], angle]))
-        return node, mbs.AddObject(items.ObjectRigidBody2D(nodeNumber=node, mass=mass, inertia=inertia))
+    _solve(exu, mbs, _solver_settings(exu, t))
+    force, crank_q, rocker_q = _stored_on_grid(mbs, sensors, t)
+    tau = -force[:, 1]
+    theta = theta0 + crank_q[:, 3]
+    psi = psi0 + rocker_q[:, 3]
+    _check_closure(design_m, (xc, yc), theta, psi, crank_q, rocker_q, theta_ref)
+    return tau, theta, psi
 
-    def pin(body0, local0, body1, local1):
-        # Local positions are in the body frames, whose reference angles are θ0, ψ0 and the coupler's φ0.
-        return [mbs.AddMarker(items.MarkerBodyPosition(bodyNumber=b, localPosition=[p[0], p[1], 0.0]))
-                for b, p in ((body0, local0), (body1, local1))]
 
-    crank_node, crank = body((0.0, 0.0), theta0, PIN_MASS, mechanism.j0 if mechanism.j0 > 0 else TINY_INERTIA)
-    rocker_node, rocker = body((xc, yc), psi0, PIN_MASS, mechanism.i_r if mechanism.i_r > 0 else TINY_INERTIA)
-    mbs.AddObject(items.ObjectJointRevolute2D(markerNumbers=pin(ground, (0.0, 0.0), crank, (0.0, 0.0))))
-    mbs.AddObject(items.ObjectJointRevolute2D(markerNumbers=pin(ground, (xc, yc), rocker, (0.0, 0.0))))
+def _add_body(mbs, items, position, angle: float, mass: float, inertia: float) -> tuple[int, int]:
+    """A rigid body (SI) with its centre of mass at ``position`` and reference angle ``angle``; its node and object."""
+    node = mbs.AddNode(items.NodeRigidBody2D(referenceCoordinates=[position[0], position[1], angle]))
+    return node, mbs.AddObject(items.ObjectRigidBody2D(nodeNumber=node, mass=mass, inertia=inertia))
+
+
+def _pin(mbs, items, body0: int, local0, body1: int, local1) -> list[int]:
+    """The two position markers of a pin joint between two bodies."""
+    # Local positions are in the body frames, whose reference angles are θ0, ψ0 and the coupler's φ0.
+    return [mbs.AddMarker(items.MarkerBodyPosition(bodyNumber=b, localPosition=[p[0], p[1], 0.0]))
+            for b, p in ((body0, local0), (body1, local1))]
+
+
+def _add_linkage(mbs, items, ground: int, design_m: np.ndarray, mechanism: FourBar, theta0: float,
+                 psi0: float) -> tuple[int, int]:
+    """Crank and rocker pinned to ground, joined by the coupler (a bar body or a distance); their nodes."""
+    oa, ab, bc = (float(v) for v in design_m)
+    xc, yc = (v * MM for v in mechanism.pivot_c)
+    a0 = np.array([oa * np.cos(theta0), oa * np.sin(theta0)])
+    b0 = np.array([xc + bc * np.cos(psi0), yc + bc * np.sin(psi0)])
+    crank_node, crank = _add_body(mbs, items, (0.0, 0.0), theta0, PIN_MASS,
+                                  mechanism.j0 if mechanism.j0 > 0 else TINY_INERTIA)
+    rocker_node, rocker = _add_body(mbs, items, (xc, yc), psi0, PIN_MASS,
+                                    mechanism.i_r if mechanism.i_r > 0 else TINY_INERTIA)
+    mbs.AddObject(items.ObjectJointRevolute2D(markerNumbers=_pin(mbs, items, ground, (0.0, 0.0), crank, (0.0, 0.0))))
+    mbs.AddObject(items.ObjectJointRevolute2D(markerNumbers=_pin(mbs, items, ground, (xc, yc), rocker, (0.0, 0.0))))
     if mechanism.coupler_mass > 0:
         mc = mechanism.coupler_mass
         phi0 = float(np.arctan2(b0[1] - a0[1], b0[0] - a0[0]))
-        _, coupler = body(0.5 * (a0 + b0), phi0, mc, mc * ab * ab / 12.0)
-        mbs.AddObject(items.ObjectJointRevolute2D(markerNumbers=pin(crank, (oa, 0.0), coupler, (-0.5 * ab, 0.0))))
-        mbs.AddObject(items.ObjectJointRevolute2D(markerNumbers=pin(coupler, (0.5 * ab, 0.0), rocker, (bc, 0.0))))
+        _, coupler = _add_body(mbs, items, 0.5 * (a0 + b0), phi0, mc, mc * ab * ab / 12.0)
+        mbs.AddObject(items.ObjectJointRevolute2D(
+            markerNumbers=_pin(mbs, items, crank, (oa, 0.0), coupler, (-0.5 * ab, 0.0))))
+        mbs.AddObject(items.ObjectJointRevolute2D(
+            markerNumbers=_pin(mbs, items, coupler, (0.5 * ab, 0.0), rocker, (bc, 0.0))))
     else:
-        mbs.AddObject(items.ObjectConnectorDistance(markerNumbers=pin(crank, (oa, 0.0), rocker, (bc, 0.0)),
+        mbs.AddObject(items.ObjectConnectorDistance(markerNumbers=_pin(mbs, items, crank, (oa, 0.0), rocker, (bc, 0.0)),
                                                     distance=ab))
+    return crank_node, rocker_node
 
-    params = _drive_params(design_m, mechanism, theta0, theta_mid)
+
+def _add_drive_and_load(mbs, items, ground_coord: int, crank_node: int, rocker_node: int, params: np.ndarray,
+                        mechanism: FourBar, psi0: float) -> int:
+    """The motor (θ(t) prescribed on the crank) and the rocker load M_r(ψ); returns the motor's constraint."""
     breaks, coefs = mechanism.load.breaks, mechanism.load.coefs
     crank_coord = mbs.AddMarker(items.MarkerNodeCoordinate(nodeNumber=crank_node, coordinate=2))
     rocker_coord = mbs.AddMarker(items.MarkerNodeCoordinate(nodeNumber=rocker_node, coordinate=2))
@@ -203,8 +233,13 @@ def _run(exudyn_modules, design_m: np.ndarray, mechanism: FourBar, t: np.ndarray
         markerNumbers=[ground_coord, rocker_coord], stiffness=0.0, damping=0.0,
         springForceUserFunction=lambda _mbs, _t, _item, u, _v, _k, _d, _off: _load_at(breaks, coefs, psi0 + u),
     ))
+    return drive
+
+
+def _add_sensors(mbs, exu, items, drive: int, crank_node: int, rocker_node: int) -> list[int]:
+    """In-memory sensors of the motor's constraint force and of the crank's and rocker's coordinates."""
     stored = {"storeInternal": True, "writeToFile": False}
-    sensors = [
+    return [
         mbs.AddSensor(items.SensorObject(objectNumber=drive, outputVariableType=exu.OutputVariableType.Force,
                                          **stored)),
         mbs.AddSensor(items.SensorNode(nodeNumber=crank_node, outputVariableType=exu.OutputVariableType.Coordinates,
@@ -212,8 +247,10 @@ def _run(exudyn_modules, design_m: np.ndarray, mechanism: FourBar, t: np.ndarray
         mbs.AddSensor(items.SensorNode(nodeNumber=rocker_node, outputVariableType=exu.OutputVariableType.Coordinates,
                                        **stored)),
     ]
-    mbs.Assemble()
 
+
+def _solver_settings(exu, t: np.ndarray):
+    """Trapezoidal rule (Newmark β = 1/4, γ = 1/2) with index-2 constraints and full Newton, fixed steps on ``t``."""
     n_steps = t.size - 1
     dt = float(t[-1] - t[0]) / n_steps
     settings = exu.SimulationSettings()
@@ -232,20 +269,25 @@ def _run(exudyn_modules, design_m: np.ndarray, mechanism: FourBar, t: np.ndarray
     ti.generalizedAlpha.useIndex2Constraints = True
     ti.generalizedAlpha.newmarkBeta = 0.25
     ti.generalizedAlpha.newmarkGamma = 0.5
+    return settings
+
+
+def _solve(exu, mbs, settings) -> None:
+    """Integrate; any failure of Exudyn's solver becomes a one-line :class:`MechoptError`."""
     try:
         ok = mbs.SolveDynamic(settings, solverType=exu.DynamicSolverType.TrapezoidalIndex2)
     except Exception as exc:  # Exudyn raises its own error types; the user gets one line
         raise MechoptError(f"Exudyn failed: {' '.join(str(exc).split())[:300]}") from None
     if not ok:
         raise MechoptError("Exudyn's solver did not converge")
+
+
+def _stored_on_grid(mbs, sensors: list[int], t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The sensors' stored rows (time first), checked to be one per step time of ``t``."""
     force, crank_q, rocker_q = (mbs.GetSensorStoredData(s) for s in sensors)
     if force.shape[0] != t.size or np.max(np.abs(force[:, 0] - t)) > 1e-9 * t[-1]:
         raise MechoptError(f"Exudyn stored {force.shape[0]} samples, expected {t.size} on the time grid")
-    tau = -force[:, 1]
-    theta = theta0 + crank_q[:, 3]
-    psi = psi0 + rocker_q[:, 3]
-    _check_closure(design_m, (xc, yc), theta, psi, crank_q, rocker_q, theta_ref)
-    return tau, theta, psi
+    return force, crank_q, rocker_q
 
 
 def _check_closure(design_m, pivot_m, theta, psi, crank_q, rocker_q, theta_ref) -> None:

@@ -186,6 +186,15 @@ class CommandSimulator:
             Any failure, with the exit code and the last lines of stderr.
         """
         payload = json.dumps({**{k: float(v) for k, v in design.items()}, "units": dict(units or {})})
+        folder = self._prepare_work_folder(design, payload)
+        returncode, out, err = self._execute(payload, folder)
+        outputs = self._read_outputs(returncode, out, err, folder)
+        if folder is not None and self.keep == "failed":
+            shutil.rmtree(folder, ignore_errors=True)
+        return outputs
+
+    def _prepare_work_folder(self, design: Mapping[str, float], payload: str) -> Path | None:
+        """Create the design's work folder afresh (with ``design.json`` for ``files``); None when there is none."""
         folder = self.work_folder(design)
         if folder is not None:
             if folder.exists():
@@ -196,6 +205,10 @@ class CommandSimulator:
                     (folder / "design.json").write_text(payload)
             except OSError as exc:
                 raise SimulatorFailure(f"cannot prepare the work folder {folder}: {exc.strerror or exc}") from None
+        return folder
+
+    def _execute(self, payload: str, folder: Path | None) -> tuple[int, bytes, bytes]:
+        """Run the program to its end (or kill its group on the timeout); its exit code, stdout and stderr."""
         argv = [resolve_entry(entry, self.folder) for entry in self.argv]
         env = {**os.environ, **dict(self.env)}
         stdin = subprocess.PIPE if self.exchange == "stdio" else subprocess.DEVNULL
@@ -219,14 +232,18 @@ class CommandSimulator:
             if proc.poll() is None:
                 proc.kill()
                 proc.wait()
+        return proc.returncode, out, err
+
+    def _read_outputs(self, returncode: int, out: bytes, err: bytes, folder: Path | None) -> dict[str, Any]:
+        """Keep the program's stdout and stderr in its work folder; its checked outputs, or the failure raised."""
         if folder is not None:
             with contextlib.suppress(OSError):
                 (folder / "stdout.txt").write_bytes(out)
                 (folder / "stderr.txt").write_bytes(err)
         tail = _stderr_tail(err)
         where = f" (work folder {folder})" if folder is not None else ""
-        if proc.returncode != 0:
-            code = proc.returncode
+        if returncode != 0:
+            code = returncode
             how = f"killed by signal {signal.Signals(-code).name}" if code < 0 and -code in signal.valid_signals() \
                 else f"exit code {code}"
             raise SimulatorFailure(f"{how}; stderr: {tail or '(empty)'}{where}")
@@ -242,7 +259,4 @@ class CommandSimulator:
             parsed = _parse_object(text)
         except ValueError as exc:
             raise SimulatorFailure(f"unparsable output {exc}{context}") from None
-        outputs = checked_outputs(parsed, self.outputs, context)
-        if folder is not None and self.keep == "failed":
-            shutil.rmtree(folder, ignore_errors=True)
-        return outputs
+        return checked_outputs(parsed, self.outputs, context)

@@ -114,13 +114,37 @@ def _state(design_m, mechanism, theta, thd):
 
 def _run(design, mechanism, dt, n, iterations, lead_steps):
     """Run ``lead_steps`` + ``n`` steps; return τ (N·m), θ (rad), x (mm) at t_k = k dt, k = 0..n−1."""
-    design_m = design * MM
-    r, l, h = design_m
     motion = mechanism.motion
     tk = (np.arange(-lead_steps, n + 1)) * dt
     theta_ref, thd_ref, _ = motion(tk)
-    a0, b0, g0, vg, vb, phi0, phid = _state(design_m, mechanism, theta_ref[0], thd_ref[0])
+    space, stator, crank, slider, motor = _build_space(design * MM, mechanism, iterations, theta_ref[0], thd_ref[0])
+    slider.velocity_func = _slider_velocity_func(mechanism)
+    target = _drive_to_target(motor, crank, dt)
 
+    inv_dt = 1.0 / dt
+    tau = np.empty(n)
+    theta = np.empty(n)
+    x = np.empty(n)
+    for j in range(lead_steps + n):
+        target[0] = theta_ref[j + 1]
+        space.step(dt)
+        k_rec = j - lead_steps
+        if k_rec >= 0:
+            tau[k_rec] = -STATOR_MOMENT * stator.angular_velocity * inv_dt
+            theta[k_rec] = crank.angle
+            x[k_rec] = slider.position.x / MM
+        stator.angular_velocity = 0.0
+        stator.angle = 0.0
+    return tau, theta, x
+
+
+def _build_space(design_m, mechanism, iterations, theta0, thd0):
+    """The space with stator, crank, slider (and rod) moving as the prescribed motion at crank angle θ0, rate θ̇0.
+
+    Returns the space, the stator, crank and slider bodies and the (still idle) motor between crank and stator.
+    """
+    r, l, h = design_m
+    a0, b0, g0, vg, vb, phi0, phid = _state(design_m, mechanism, theta0, thd0)
     space = pymunk.Space()
     space.gravity = (0.0, -mechanism.gravity)
     space.damping = 1.0
@@ -130,8 +154,8 @@ def _run(design, mechanism, dt, n, iterations, lead_steps):
 
     stator = pymunk.Body(PIN_MASS, STATOR_MOMENT)
     crank = pymunk.Body(PIN_MASS, mechanism.j0 if mechanism.j0 > 0 else 1e-9)
-    crank.angle = float(theta_ref[0])
-    crank.angular_velocity = float(thd_ref[0])
+    crank.angle = float(theta0)
+    crank.angular_velocity = float(thd0)
     slider = pymunk.Body(mechanism.slider_mass, 1.0)
     slider.position = tuple(b0)
     slider.velocity = tuple(vb)
@@ -158,7 +182,11 @@ def _run(design, mechanism, dt, n, iterations, lead_steps):
     # Chipmunk's motor enforces ω_b − ω_a = −rate: with a = crank and b = the (resting) stator, ω_crank = rate.
     motor = pymunk.SimpleMotor(crank, stator, 0.0)
     space.add(*joints, motor)
+    return space, stator, crank, slider, motor
 
+
+def _slider_velocity_func(mechanism):
+    """The slider's ``velocity_func``: gravity plus the spring and the external force on it."""
     k = mechanism.spring_k / MM
     x_free = mechanism.spring_free_mm * MM
     force = mechanism.force
@@ -169,8 +197,14 @@ def _run(design, mechanism, dt, n, iterations, lead_steps):
         f = -k * (body.position.x - x_free) + force
         pymunk.Body.update_velocity(body, (gravity[0] + f / mass, gravity[1]), damping, step)
 
-    slider.velocity_func = slider_velocity
+    return slider_velocity
 
+
+def _drive_to_target(motor, crank, dt):
+    """Set the motor's rate before every solve so the crank lands on ``target[0]`` (rad) at the end of the step.
+
+    Returns the one-element list ``target``, which the caller updates before each step.
+    """
     target = [0.0]
     inv_dt = 1.0 / dt
 
@@ -178,18 +212,4 @@ def _run(design, mechanism, dt, n, iterations, lead_steps):
         motor.rate = (target[0] - crank.angle) * inv_dt
 
     motor.pre_solve = drive
-
-    tau = np.empty(n)
-    theta = np.empty(n)
-    x = np.empty(n)
-    for j in range(lead_steps + n):
-        target[0] = theta_ref[j + 1]
-        space.step(dt)
-        k_rec = j - lead_steps
-        if k_rec >= 0:
-            tau[k_rec] = -STATOR_MOMENT * stator.angular_velocity * inv_dt
-            theta[k_rec] = crank.angle
-            x[k_rec] = slider.position.x / MM
-        stator.angular_velocity = 0.0
-        stator.angle = 0.0
-    return tau, theta, x
+    return target

@@ -12,6 +12,7 @@
     workdir = "runs"                      # command only: per-design work folders, relative to the study file
     keep = "failed"                       # command only: or "all" (keep every design's work folder)
     env = { MY_LICENSE = "..." }          # command only: added to the environment
+    seconds_per_run = 85                  # what one simulation costs (s): the plan before a run estimates from it
 
 ``{python}`` in the command is the interpreter running mechopt; ``{study}`` the study file's folder.
 """
@@ -28,9 +29,10 @@ from mechopt.sim.simulators.problem import ExternalProblem
 from mechopt.sim.simulators.python_callable import CallableSimulator, module_file, split_target
 from mechopt.studies.study_file import StudyFile
 
-__all__ = ["SIMULATOR_KEYS", "simulator_from_study", "with_simulator"]
+__all__ = ["SIMULATOR_KEYS", "declared_seconds_per_run", "simulator_from_study", "with_simulator"]
 
-_COMMON_KEYS = {"outputs", "objective", "fit"}
+# seconds_per_run is not part of the simulator (nor of the samples' fingerprint): only the plan reads it.
+_COMMON_KEYS = {"outputs", "objective", "fit", "seconds_per_run"}
 _COMMAND_KEYS = {"command", "timeout_s", "exchange", "workdir", "keep", "env"}
 SIMULATOR_KEYS = _COMMON_KEYS | _COMMAND_KEYS | {"callable"}
 
@@ -45,6 +47,20 @@ def _outputs(study: StudyFile, section: dict) -> tuple[str, ...]:
         raise StudyError(f"{study.where}: key simulator.outputs = {value!r} must be distinct names other than "
                          f"{INFEASIBLE_KEY!r}")
     return tuple(value)
+
+
+def declared_seconds_per_run(study: StudyFile) -> float | None:
+    """``[simulator] seconds_per_run``: the declared wall time of one simulation (s), None when not declared.
+
+    Raises
+    ------
+    StudyError
+        A value that is not a positive finite number.
+    """
+    section = study.table("simulator", required=False)
+    if "seconds_per_run" not in section:
+        return None
+    return study.number(section, "seconds_per_run", "simulator", positive=True)
 
 
 def simulator_from_study(study: StudyFile) -> CommandSimulator | CallableSimulator:
@@ -110,6 +126,7 @@ def with_simulator(study: StudyFile, base: DesignProblem) -> ExternalProblem:
     """
     section = study.table("simulator", SIMULATOR_KEYS)
     simulator = simulator_from_study(study)
+    declared_seconds_per_run(study)  # checked when the study is loaded, before any plan or simulation
     outputs = simulator.outputs
     if "objective" in section:
         objective = study.string(section, "objective", "simulator", choices=outputs)

@@ -59,3 +59,106 @@ def test_headline_across_studies_with_known_optima(tmp_path, capsys):
     data = json.loads((tmp_path / "branin" / "compare.json").read_text())
     assert data["truth"]["key"] == "known" and data["tolerance"] == pytest.approx(0.005 * 307.73)
     assert (tmp_path / "figures" / "compare_headline.png").read_bytes()[:4] == b"\x89PNG"
+
+
+# --------------------------------------------------------------------------- runs that stop before their budget
+class PeerDefect(RuntimeError):
+    """What a library's defect looks like to the comparison: an exception in the middle of a run."""
+
+
+def _branin_designs(problem, n: int, seed: int) -> np.ndarray:
+    # The first design is a global minimiser of Branin (f* = 0.3979): a run that stops after it "reached" the
+    # optimum, so only the rule that unfinished runs are not counted keeps it out of the headline.
+    rest = problem.sample_feasible(n - 1, np.random.default_rng(seed))
+    return np.vstack([[np.pi, 2.275], rest])
+
+
+def flaky_peer(problem, seed: int):
+    """Test-only baseline: simulates designs one by one and raises at its 5th when seed is 0."""
+    for i, x in enumerate(_branin_designs(problem, problem.budget, seed)):
+        if seed == 0 and i == 4:
+            raise PeerDefect("only 0-dimensional arrays can be converted to Python scalars")
+        problem.evaluate(x if seed == 0 else x + [0.0, 0.1 * (i == 0)])  # seed 1 misses the minimiser
+    return problem.result("budget spent")
+
+
+def quiet_peer(problem, seed: int):
+    """Test-only library peer that stops after 5 simulations without an error (a wrapper swallowing one)."""
+    for x in _branin_designs(problem, 5, seed):
+        problem.evaluate(x)
+    return problem.result("stopped quietly")
+
+
+@pytest.fixture
+def test_only_peers(monkeypatch):
+    from mechopt.cli import compare as cmp
+    from mechopt.optimize.baselines import BASELINES
+
+    # Registered where `mechopt compare` and `mechopt.minimize` resolve method names; quiet_peer counts as a
+    # library peer, one that must spend its whole budget.
+    monkeypatch.setitem(BASELINES, "flaky_peer", flaky_peer)
+    monkeypatch.setitem(BASELINES, "quiet_peer", quiet_peer)
+    monkeypatch.setattr(cmp, "SPENDS_WHOLE_BUDGET", cmp.SPENDS_WHOLE_BUDGET | {"quiet_peer"})
+
+
+def test_a_peer_failing_part_way_is_marked_and_not_counted(tmp_path, capsys, test_only_peers):
+    args = ["compare", "--study", "branin", "--budgets", "20", "--seeds", "2", "--out", str(tmp_path), "--methods",
+            "slsqp,flaky_peer,quiet_peer"]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    # Printed as it happens, with the simulations spent and the reason.
+    assert ("flaky_peer at budget 20, seed 0: 4 of 20 simulations, stopped before its budget (raised PeerDefect: "
+            "only 0-dimensional arrays") in out
+    assert "flaky_peer at budget 20, seed 1: 20 of 20 simulations," in out
+    assert "quiet_peer at budget 20, seed 0: 5 of 20 simulations, stopped before its budget (ended with 15" in out
+    assert "slsqp at budget 20, seed 0:" in out and "of 20 simulations" in out
+
+    data = json.loads((tmp_path / "compare.json").read_text())
+    runs = {(r["method"], r["seed"]): r for r in data["runs"]}
+    flaky0, flaky1 = runs["flaky_peer", 0], runs["flaky_peer", 1]
+    assert (flaky0["nfev"], flaky0["finished"]) == (4, False) and "PeerDefect" in flaky0["reason"]
+    assert flaky0["value"] == pytest.approx(0.397887, abs=1e-5)  # it had found the optimum before it failed
+    assert (flaky1["nfev"], flaky1["finished"], flaky1["reason"]) == (20, True, "")
+    assert all(not runs["quiet_peer", s]["finished"] and runs["quiet_peer", s]["nfev"] == 5 for s in (0, 1))
+    assert all(runs["slsqp", s]["finished"] for s in (0, 1))
+
+    rows = {r["method"]: r for r in data["rows"]}
+    # The median is the finished run's alone: the failed run's optimum is not in it.
+    assert rows["flaky_peer"]["median_value"] == pytest.approx(flaky1["value"])
+    assert flaky1["value"] > flaky0["value"] + 1e-3
+    assert (rows["flaky_peer"]["unfinished"], rows["flaky_peer"]["complete"]) == (1, False)
+    assert (rows["quiet_peer"]["unfinished"], rows["slsqp"]["unfinished"]) == (2, 0)
+    # quiet_peer's first design is the optimum in both runs, yet it never counts as having reached it.
+    assert runs["quiet_peer", 0]["gap_pct"] == pytest.approx(0.0, abs=1e-4)
+    assert data["needed"]["quiet_peer"] is None and data["needed"]["flaky_peer"] is None
+    assert data["unfinished_methods"] == ["flaky_peer", "quiet_peer"]
+
+    md = (tmp_path / "compare.md").read_text()
+    assert "| flaky_peer | 20 | 2 |" in md and "| 1 † |" in md and "| 2 † |" in md
+    assert "| quiet_peer | 20 | 2 | — | — | — | — | — |" in md  # nothing finished: nothing scored
+    assert "3 run(s) stopped before spending their budget and are not counted" in md
+    assert "- flaky_peer at budget 20, seed 0: 4 of 20 simulations, stopped before its budget (raised" in md
+    assert "| flaky_peer | " in md.split("Median gap")[1] and "% † |" in md.split("Median gap")[1]
+
+
+def test_the_headline_marks_methods_with_unfinished_runs():
+    from mechopt.cli.compare import headline, unfinished_methods
+
+    rows = [{"method": "peer", "budget": 30, "median_reached": True, "complete": False},
+            {"method": "ours", "budget": 30, "median_reached": True, "complete": True}]
+    assert unfinished_methods(rows) == {"peer"}
+    text = headline({"f": {"peer": None, "ours": 30}}, {"f": 30}, {"f": unfinished_methods(rows)})
+    assert "| peer | > 30 † |" in text and "| ours | 30 |" in text and "not counted" in text
+    assert "†" not in headline({"f": {"peer": None, "ours": 30}}, {"f": 30})
+
+
+def test_smt_ego_beyond_its_limit_is_refused_in_one_line(tmp_path, capsys):
+    from mechopt.cli.compare import EGO_MAX_BUDGET
+
+    too_many = EGO_MAX_BUDGET + 1
+    code = main(["compare", "--study", "branin", "--out", str(tmp_path), "--seeds", "1", "--budgets",
+                 f"20,{too_many}", "--methods", "slsqp,smt_ego"])
+    assert code == EXIT_ERROR
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"smt_ego at budget {too_many}" in err[0] and f"limit of {EGO_MAX_BUDGET}" in err[0]
+    assert not (tmp_path / "compare.json").exists()  # refused before any run

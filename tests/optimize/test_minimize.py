@@ -44,13 +44,13 @@ F_STAR = 1.0 + (R - 1.5) ** 2
 
 def test_a_problem_defined_in_a_test_file_is_minimised_through_the_store(tmp_path):
     store = tmp_path / "bracket.sqlite"
-    result = mechopt.minimize(Bracket(), budget=60, store=store, seed=1)
+    result = mechopt.minimize(Bracket(), budget=60, method="sparse", store=store, seed=1)
     assert result.success and result.nfev <= 60
     np.testing.assert_allclose(result.x, X_STAR, atol=2e-3)
     assert result.fun == pytest.approx(F_STAR, rel=1e-4)
     assert result.outputs["f"] == result.fun and result.nnew == result.nfev
     # The same call again: every design comes from the store, none is simulated twice.
-    again = mechopt.minimize(Bracket(), budget=60, store=store, seed=1)
+    again = mechopt.minimize(Bracket(), budget=60, method="sparse", store=store, seed=1)
     assert again.nnew == 0 and again.nreused == again.nfev
     np.testing.assert_array_equal(again.x, result.x)
 
@@ -70,7 +70,7 @@ class Smooth4(mechopt.DesignProblem):
 
 
 def test_the_pipeline_finds_the_minimum_of_a_smooth_4d_function():
-    result = mechopt.minimize(Smooth4(), budget=300, seed=0, options={"refine": False})
+    result = mechopt.minimize(Smooth4(), budget=300, method="sparse", seed=0, options={"refine": False})
     # The model alone (10 lines at Fekete nodes, no local search) is within 0.5 % of the minimum, 2.0.
     assert result.fun <= 2.0 * 1.005
     assert result.stages[0].plan.dim == 4 and result.nfev <= 300
@@ -80,7 +80,7 @@ def test_refinement_improves_on_the_model_candidate_within_the_budget(ventilator
     problem = mechopt.load_study("ventilator", {"engine": "analytic"}).problem
     # The small first plan of a small budget (3 lines of 4 samples) misses the optimum, which lies on the region's
     # boundary: the model's steps and the local search on the simulator must take over, within the budget.
-    result = mechopt.minimize(problem, budget=40, seed=0, options={"search_points": 200_000})
+    result = mechopt.minimize(problem, budget=40, method="sparse", seed=0, options={"search_points": 200_000})
     global_stage, stepped, *refined = result.stages
     assert stepped.name == "model steps" and stepped.n_samples > 0
     # SLSQP may stop with budget left (a converged search): steps on the corrected model then use it.
@@ -149,10 +149,10 @@ def test_trust_report_says_whether_the_model_resolves_the_landscape():
     from mechopt.studies.test_functions import Hartmann3
 
     # A smooth bowl cut by a disc: 7 lines resolve it, the model's claim and its leave-one-line-out error agree.
-    smooth = mechopt.minimize(Bracket(), budget=200, seed=1)
+    smooth = mechopt.minimize(Bracket(), budget=200, method="sparse", seed=1)
     assert smooth.trust["resolved"] and smooth.trust["lolo_median"] < 0.05
     assert smooth.trust["verdict"].startswith("the global model resolves the landscape")
     # Hartmann-3 (four basins, the global one narrow): the same plan cannot resolve it, and says so.
-    rough = mechopt.minimize(Hartmann3(), budget=150, seed=0)
+    rough = mechopt.minimize(Hartmann3(), budget=150, method="sparse", seed=0)
     assert not rough.trust["resolved"] and rough.trust["lolo_median"] > 0.05
     assert "does not resolve" in rough.trust["verdict"] and "sparse-global" in rough.trust["verdict"]

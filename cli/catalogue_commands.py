@@ -1,0 +1,107 @@
+"""Commands on what mechopt ships: ``mechopt studies`` (the studies and test functions, one line each),
+``mechopt methods`` (the optimizers ``--method`` accepts) and ``mechopt init`` (copy a study to start one's own)."""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+import tomllib
+from pathlib import Path
+
+from mechopt.errors import InputError
+
+__all__ = ["add_parsers", "method_lines", "run_init", "run_methods", "run_studies", "study_lines"]
+
+#: One line for each line-model method (the baselines carry theirs in ``BASELINE_DOCS``).
+_SPARSE_DOCS = {
+    "auto": "the default of mechopt.minimize: Gaussian-process steps (Matern-5/2, expected improvement) on a plan "
+    "chosen by d and budget (one global model to 4 variables, restarted trust regions above), failed simulations "
+    "learned and avoided (budget >= 2d + 2).",
+    "sparse": "paper 002's line model: lines sampled, fitted by sums of exponentials, blended by Chebyshev "
+    "interpolation, searched exhaustively, refined on the simulator (2 to 4 variables; smooth landscapes).",
+    "sparse-global": "the same lines and blend made global on multimodal landscapes: basins of the blend simulated, "
+    "then steps on the blend corrected by every simulation (2 to 4 variables).",
+}
+
+
+def add_parsers(sub) -> None:
+    """Add ``studies``, ``methods`` and ``init`` to the subcommands."""
+    p = sub.add_parser("studies", help="list the packaged studies and test functions, one line each")
+    p.set_defaults(func=run_studies)
+    p = sub.add_parser("methods", help="list the optimizers `--method` accepts, one line each")
+    p.set_defaults(func=run_methods)
+    p = sub.add_parser("init", help="copy a packaged study (its TOML and data) to start a study of your own")
+    p.add_argument("name", help="the packaged study to copy (e.g. ventilator)")
+    p.add_argument("--to", metavar="DIR", help="folder to copy it into (default: my-NAME; must be new or empty)")
+    p.set_defaults(func=run_init)
+
+
+def study_lines() -> list[str]:
+    """``name  kind, d variables: description`` for every packaged study, then every test function.
+
+    The study files are read as TOML only: building a study's problem can cost seconds (the ventilator's
+    reconstruction), and a list needs none of it.
+    """
+    from mechopt.studies.catalogue import STUDIES_DIR
+    from mechopt.studies.test_functions import SUITE
+
+    rows = []
+    for path in sorted(STUDIES_DIR.glob("*/study.toml")):
+        config = tomllib.loads(path.read_text())
+        name = config.get("name", path.parent.name.replace("_", "-"))
+        dim = len(config.get("variables", {}))
+        rows.append((name, f"{config.get('kind', '?')}, {dim} variables", str(config.get("description", ""))))
+    for name, cls in sorted(SUITE.items()):
+        doc = (cls.__doc__ or name).strip().splitlines()[0].rstrip(".")
+        rows.append((name, f"test function, {cls().dim} variables", doc))
+    width = max(len(r[0]) for r in rows)
+    return [f"{name:<{width}}  {what}: {text}" for name, what, text in rows]
+
+
+def method_lines() -> list[str]:
+    """``name  description`` for every method of :func:`mechopt.minimize`."""
+    from mechopt.optimize.arguments import available_methods
+    from mechopt.optimize.baselines import BASELINE_DOCS
+
+    docs = {**_SPARSE_DOCS, **BASELINE_DOCS}
+    names = available_methods()
+    width = max(map(len, names))
+    return [f"{name:<{width}}  {docs.get(name, '')}" for name in names]
+
+
+def run_studies(args: argparse.Namespace, rest: list[str]) -> int:
+    """Print the catalogue."""
+    print("\n".join(study_lines()))
+    print("\nrun one with `mechopt study NAME`; compare optimizers on any of them with `mechopt compare --study NAME`")
+    return 0
+
+
+def run_methods(args: argparse.Namespace, rest: list[str]) -> int:
+    """Print the methods."""
+    print("\n".join(method_lines()))
+    print("\nchoose one with `mechopt study NAME --method METHOD` or `mechopt.minimize(problem, method=...)`")
+    return 0
+
+
+def run_init(args: argparse.Namespace, rest: list[str]) -> int:
+    """Copy a packaged study's files into a new folder."""
+    from mechopt.studies.catalogue import STUDIES_DIR, available_studies
+
+    folder = STUDIES_DIR / args.name.replace("-", "_")
+    if not (folder / "study.toml").is_file():
+        raise InputError(f"unknown study {args.name!r}; expected one of {', '.join(available_studies())}")
+    to = Path(args.to or f"my-{args.name}")
+    if to.exists() and (not to.is_dir() or any(to.iterdir())):
+        raise InputError(f"{to} exists and is not an empty folder; name another with --to")
+    try:
+        to.mkdir(parents=True, exist_ok=True)
+        copied = []
+        for f in sorted(folder.iterdir()):
+            if f.is_file() and f.suffix in (".toml", ".csv", ".md", ".json", ".py") and f.name != "__init__.py":
+                shutil.copy2(f, to / f.name)
+                copied.append(f.name)
+    except OSError as exc:
+        raise InputError(f"cannot copy the study into {to}: {exc.strerror or exc}") from None
+    print(f"copied {', '.join(copied)} to {to}; edit {to / 'study.toml'} (give it a new name) and run "
+          f"`mechopt study {to / 'study.toml'}`")
+    return 0

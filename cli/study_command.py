@@ -1,0 +1,60 @@
+"""``mechopt study``: run a whole study (optimise, validate, evaluate the reference designs, report)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from mechopt.cli.arguments import count, positive_float
+from mechopt.cli.study_arguments import add_method_option, add_run_options, load, overrides
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(sub, engines: tuple[str, ...]) -> None:
+    """Add ``study`` to the subcommands."""
+    p = sub.add_parser("study", help="run a study: sample, fit, search, refine, validate, report")
+    p.add_argument("name", nargs="?", default="ventilator",
+                   help="study name or .toml path (default: ventilator; `mechopt studies` lists them)")
+    p.add_argument("--engine", choices=engines, help="simulation engine (default: the study's)")
+    add_method_option(p)
+    add_run_options(p)
+    p.add_argument("--lines", type=count, help="most held-out validation lines (default 10; 0: no validation)")
+    p.add_argument("--validation", type=count, metavar="N",
+                   help="held-out simulations on top of the budget (default: 20 %% of the budget; 300 = the "
+                   "ventilator's full 10 lines x 30 of earlier versions; 0: no validation)")
+    p.add_argument("--dry-run", action="store_true",
+                   help="print the plan (stages, simulations, expected wall time) and simulate nothing")
+    p.add_argument("--truth", action="store_true", help="also brute-force the ground truth (cached)")
+    p.add_argument("--truth-grid", type=positive_float, default=1.0, help="its grid step (the variables' unit)")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace, rest: list[str]) -> int:
+    """Run the study named on the command line and print its summary."""
+    from mechopt.cli.run_study import check_output_folder, plan_study, run_study, study_options, summary_lines
+    from mechopt.optimize.arguments import check_budget, check_method
+
+    study = load(args, args.name)
+    if args.budget is not None:
+        check_budget(args.budget)
+    check_method(args.method, study.problem.dim, study.name)
+    options = study_options(study, overrides(args), log=print)
+    out_arg = Path(args.out or f"{study.name}-study")
+    if args.dry_run:
+        store = Path(args.store) if args.store else out_arg / "samples.sqlite"
+        plan = plan_study(study, options, workers=args.workers, scheduler=args.scheduler, store_path=store,
+                          retry_failed=args.retry_failed, method=args.method)
+        from mechopt.cli.study_header import study_header
+
+        print("\n".join([*study_header(study), f"  store {store}", *plan.text()]))
+        print("dry run: nothing simulated")
+        return 0
+    out = check_output_folder(out_arg)
+    run = run_study(study, out, options, workers=args.workers, scheduler=args.scheduler, store_path=args.store,
+                    progress=not args.no_progress, truth=args.truth, truth_step=args.truth_grid,
+                    retry_failed=args.retry_failed, method=args.method)
+    print("\n".join(summary_lines(run)))
+    print(f"report: {out / 'report.md'}")
+    return 0
+

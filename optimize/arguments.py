@@ -1,0 +1,85 @@
+"""The checks of :func:`mechopt.minimize`'s arguments, shared with the command line so both refuse the same values
+with the same one-line message, before any simulation."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from mechopt.errors import InputError
+
+__all__ = ["AUTO_METHOD", "MIN_BUDGET", "SPARSE_METHODS", "available_methods", "check_budget", "check_method",
+           "check_seed", "check_workers"]
+
+#: The fewest simulations any method is given: a model needs a few designs before it can propose one.
+MIN_BUDGET = 3
+
+#: The line-model methods of paper 002 (``mechopt.optimize.sparse`` and ``mechopt.optimize.sparse_global``).
+SPARSE_METHODS = ("sparse", "sparse-global")
+
+#: The default method of :func:`mechopt.minimize` (:mod:`mechopt.optimize.auto`): its plan follows d and the budget.
+AUTO_METHOD = "auto"
+
+
+def _baselines() -> dict[str, Callable[..., Any]]:
+    from mechopt.optimize.baselines import BASELINES
+
+    return BASELINES
+
+
+def available_methods() -> list[str]:
+    """Every method name :func:`mechopt.minimize` and ``mechopt study --method`` accept."""
+    return [AUTO_METHOD, *SPARSE_METHODS, *_baselines()]
+
+
+def _whole(value: Any) -> bool:
+    return not isinstance(value, bool) and isinstance(value, int | np.integer)
+
+
+def check_budget(budget: Any) -> int:
+    """``budget`` as an int, or an :class:`InputError` naming it (a whole number of simulations >= 3)."""
+    if not _whole(budget) or budget < MIN_BUDGET:
+        raise InputError(f"budget = {budget!r}: expected a whole number of simulations >= {MIN_BUDGET}")
+    return int(budget)
+
+
+def check_seed(seed: Any) -> int:
+    """``seed`` as an int, or an :class:`InputError` naming it (a whole number >= 0)."""
+    if not _whole(seed) or seed < 0:
+        raise InputError(f"seed = {seed!r}: expected a whole number >= 0")
+    return int(seed)
+
+
+def check_workers(workers: Any) -> int | None:
+    """``workers`` (None: every core), or an :class:`InputError` naming it (a whole number >= 1)."""
+    if workers is not None and (not _whole(workers) or workers < 1):
+        raise InputError(f"workers = {workers!r}: expected a whole number >= 1")
+    return workers
+
+
+def check_method(method: Any, dim: int, name: str = "the problem", budget: int | None = None) -> None:
+    """Refuse an unknown method name, a line-model method outside its 2 to 4 design variables, or a budget below
+    the default method's 2d + 2.
+
+    Parameters
+    ----------
+    method : str or callable
+        A name of :func:`available_methods`, or ``f(counted_problem, seed) -> OptimizeResult``.
+    dim : int
+        The problem's number of design variables.
+    name : str
+        The problem's name, for the message.
+    budget : int, optional
+        The budget (checked against the default method's minimum when given).
+    """
+    if callable(method):
+        return
+    if method not in available_methods():
+        raise InputError(f"method = {method!r}; expected one of {', '.join(available_methods())} or a callable")
+    if method in SPARSE_METHODS and not 2 <= dim <= 4:
+        raise InputError(f"method {method!r} handles 2 to 4 design variables; {name!r} has {dim}")
+    if method == AUTO_METHOD and budget is not None and budget < 2 * dim + 2:
+        raise InputError(f"budget = {budget}: method {method!r} needs at least 2d + 2 = {2 * dim + 2} simulations "
+                         f"for the {dim} variables of {name!r}")

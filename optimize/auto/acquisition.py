@@ -1,0 +1,143 @@
+"""Where to simulate next: the expected improvement of a GP, weighted by the probability that the simulation
+succeeds, maximised over a box of the unit cube; several designs at once by the kriging believer.
+
+The log of the expected improvement is used (Ament et al. 2023): far from the best design the improvement
+underflows to 0 in floating point and every candidate would tie; its logarithm keeps ranking them.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+from scipy.optimize import minimize
+from scipy.special import ndtr
+from scipy.stats import qmc
+
+from mechopt.optimize.auto.gp import GaussianProcess
+
+__all__ = ["log_expected_improvement", "propose_batch"]
+
+_LOG_SQRT_2PI = 0.5 * math.log(2.0 * math.pi)
+
+#: ``log_feasible(U) -> (m,)``: log-probability that designs U (unit cube) simulate successfully.
+LogFeasible = Callable[[np.ndarray], np.ndarray]
+
+
+def log_expected_improvement(gp: GaussianProcess, U: np.ndarray, best: float) -> np.ndarray:
+    """log E[max(best − f(U), 0)] under the GP, at designs U (m, d) of the unit cube."""
+    mean, sd = gp.predict(U)
+    u = (best - mean) / sd
+    phi_log = -0.5 * u * u - _LOG_SQRT_2PI
+    with np.errstate(divide="ignore", invalid="ignore"):
+        direct = np.log(np.maximum(u * ndtr(u) + np.exp(phi_log), 1e-300))
+        # h(u) = φ(u) + u Φ(u) ~ φ(u) / u² (1 − 3/u²) as u → −∞, where the direct sum cancels.
+        tail = phi_log - 2.0 * np.log(np.abs(u)) + np.log1p(-3.0 / np.maximum(u * u, 9.0))
+    log_h = np.where(u > -5.0, direct, tail)
+    return log_h + np.log(sd)
+
+
+def _candidates(lo: np.ndarray, hi: np.ndarray, centre: np.ndarray, n: int, rng: np.random.Generator) -> np.ndarray:
+    """Sobol points of the box, and as many that move only a few coordinates of the centre (TuRBO's perturbation:
+    in many dimensions a point that changes every coordinate is almost never better)."""
+    d = lo.size
+    sobol = qmc.Sobol(d, seed=rng).random_base2(max(1, round(math.log2(n))))
+    n = sobol.shape[0]
+    box = lo + sobol * (hi - lo)
+    mask = rng.random((n, d)) < min(1.0, 20.0 / d)
+    mask[np.arange(n), rng.integers(0, d, n)] = True
+    local = np.where(mask, box, centre)
+    return np.vstack([box, local])
+
+
+def _with_gradient(score: Callable[[np.ndarray], np.ndarray], lo: np.ndarray,
+                   hi: np.ndarray) -> Callable[[np.ndarray], tuple[float, np.ndarray]]:
+    """−score and its forward-difference gradient from one batched call (d + 1 designs: one model prediction
+    instead of d + 1, which is what a polish step costs)."""
+    h = 1e-6 * np.maximum(hi - lo, 1e-12)
+
+    def fun(u: np.ndarray) -> tuple[float, np.ndarray]:
+        # Step inwards at the upper bound so every difference stays in the box.
+        step = np.where(u + h <= hi, h, -h)
+        s = -score(np.vstack([u, u + np.diag(step)]))
+        return float(s[0]), (s[1:] - s[0]) / step
+
+    return fun
+
+
+def _maximise(score: Callable[[np.ndarray], np.ndarray], lo: np.ndarray, hi: np.ndarray, C: np.ndarray,
+              allowed: Callable[[np.ndarray], np.ndarray], polish: int) -> np.ndarray | None:
+    """The best allowed candidate, polished by L-BFGS-B from the ``polish`` best ones (kept when allowed)."""
+    C = C[allowed(C)]
+    if not C.shape[0]:
+        return None
+    s = score(C)
+    order = np.argsort(-s)
+    best_x, best_s = C[order[0]], s[order[0]]
+    for x0 in C[order[:polish]]:
+        res = minimize(_with_gradient(score, lo, hi), x0, jac=True, method="L-BFGS-B",
+                       bounds=list(zip(lo, hi, strict=True)), options={"maxiter": 30})
+        if -res.fun > best_s and allowed(res.x[None, :])[0]:
+            best_x, best_s = res.x, -res.fun
+    return np.asarray(best_x, dtype=float)
+
+
+def propose_batch(gp: GaussianProcess, best: float, lo: np.ndarray, hi: np.ndarray, centre: np.ndarray, q: int,
+                  rng: np.random.Generator, allowed: Callable[[np.ndarray], np.ndarray],
+                  log_feasible: LogFeasible | None = None, n_candidates: int = 1024,
+                  polish: int = 3, kappa: float | None = None) -> np.ndarray:
+    """``q`` designs of the box [lo, hi] (unit cube) maximising log EI + log P(success), one after the other, each
+    chosen with the previous ones believed at their posterior mean (Ginsbourger et al. 2010).
+
+    Parameters
+    ----------
+    gp : GaussianProcess
+        Model of the standardised targets.
+    best : float
+        The incumbent standardised target.
+    lo, hi : (d,) ndarray
+        Box searched (unit cube coordinates).
+    centre : (d,) ndarray
+        Design whose neighbours are offered as candidates too (the incumbent).
+    q : int
+        Designs wanted.
+    rng : Generator
+    allowed : callable
+        ``allowed(U) -> bool (m,)``: designs that may be simulated (declared constraints, not already simulated).
+    log_feasible : callable, optional
+        Log-probability that a design's simulation succeeds (learned from failures); None when none failed.
+    n_candidates, polish : int
+        Random candidates of each choice and L-BFGS-B starts among the best of them.
+    kappa : float, optional
+        Minimise the lower confidence bound mean − kappa·sd instead (exploitation, for a final polish).
+
+    Returns
+    -------
+    (k, d) ndarray
+        k <= q designs (fewer only when no allowed candidate is left in the box).
+    """
+    chosen: list[np.ndarray] = []
+    model = gp
+    for _ in range(q):
+        def score(U: np.ndarray, model: GaussianProcess = model) -> np.ndarray:
+            if kappa is None:
+                s = log_expected_improvement(model, U, best)
+            else:
+                mean, sd = model.predict(U)
+                s = kappa * sd - mean
+            return s + log_feasible(U) if log_feasible is not None else s
+
+        def fresh(U: np.ndarray) -> np.ndarray:
+            ok = allowed(U)
+            for x in chosen:
+                ok &= np.max(np.abs(U - x), axis=1) > 1e-6
+            return ok
+
+        x = _maximise(score, lo, hi, _candidates(lo, hi, centre, n_candidates, rng), fresh, polish)
+        if x is None:
+            break
+        chosen.append(x)
+        if len(chosen) < q:
+            model = model.believe(x[None, :])
+    return np.array(chosen).reshape(-1, lo.size)

@@ -1,0 +1,137 @@
+"""A Gaussian process on the unit cube: Matérn-5/2 kernel with one length-scale per variable, hyperparameters by
+maximum marginal likelihood (ML-II), optionally with a weak prior, several starts.
+
+The optional prior on the length-scales is the dimension-scaled log-normal of Hvarfner, Hellsten & Nardi (2024):
+log ℓ ~ N(√2 + ½ log d, √3), derived for many variables, where a few dozen designs leave most length-scales
+undetermined and plain ML-II collapses them onto tiny values (every unexplored point then looks equally
+promising).  In 2 to 4 variables the designs fix the length-scales and the prior only biases them long.
+Targets are expected standardised (:mod:`mechopt.optimize.auto.transform`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.linalg import cho_solve, solve_triangular
+from scipy.optimize import minimize
+
+__all__ = ["GaussianProcess", "fit_gp"]
+
+_SQRT5 = math.sqrt(5.0)
+#: Bounds of log length-scale (unit cube), log signal variance and log noise variance (standardised targets).
+_LOG_ELL = (math.log(5e-3), math.log(50.0))
+_LOG_SIGNAL = (math.log(0.05), math.log(20.0))
+_LOG_NOISE = (math.log(1e-6), math.log(0.1))
+
+
+def _matern(U: np.ndarray, V: np.ndarray, ell: np.ndarray, signal: float) -> tuple[np.ndarray, np.ndarray]:
+    """Matérn-5/2 covariance of designs U (n, d) and V (m, d), and its factor W with ∂k/∂log ℓ_k = W (Δ_k/ℓ_k)²."""
+    A, B = U / ell, V / ell
+    r2 = np.maximum(np.sum(A * A, 1)[:, None] + np.sum(B * B, 1)[None, :] - 2.0 * A @ B.T, 0.0)
+    r = np.sqrt(r2)
+    e = np.exp(-_SQRT5 * r)
+    K = signal * (1.0 + _SQRT5 * r + 5.0 / 3.0 * r2) * e
+    W = signal * 5.0 / 3.0 * (1.0 + _SQRT5 * r) * e
+    return K, W
+
+
+class GaussianProcess:
+    """A fitted GP: posterior mean and standard deviation of standardised targets at new designs.
+
+    Parameters
+    ----------
+    X : (n, d) ndarray
+        Designs in the unit cube.
+    y : (n,) ndarray
+        Standardised targets (zero prior mean).
+    theta : (d + 2,) ndarray
+        log length-scales, log signal variance, log noise variance.
+    """
+
+    def __init__(self, X: np.ndarray, y: np.ndarray, theta: np.ndarray) -> None:
+        self.X, self.y, self.theta = np.asarray(X, float), np.asarray(y, float), np.asarray(theta, float)
+        d = self.X.shape[1]
+        self.ell = np.exp(self.theta[:d])
+        self.signal, self.noise = math.exp(self.theta[d]), math.exp(self.theta[d + 1])
+        K, _ = _matern(self.X, self.X, self.ell, self.signal)
+        K[np.diag_indices_from(K)] += self.noise
+        self.L = np.linalg.cholesky(K)
+        self.alpha = cho_solve((self.L, True), self.y)
+
+    def predict(self, U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Posterior mean and standard deviation (of the latent function, no noise) at designs U (m, d)."""
+        Ks, _ = _matern(np.atleast_2d(U), self.X, self.ell, self.signal)
+        mean = Ks @ self.alpha
+        V = solve_triangular(self.L, Ks.T, lower=True)
+        var = np.maximum(self.signal - np.sum(V * V, axis=0), 1e-12 * self.signal)
+        return mean, np.sqrt(var)
+
+    def believe(self, U: np.ndarray) -> GaussianProcess:
+        """The same GP with designs U (m, d) added at their posterior mean (the kriging believer of a batch)."""
+        U = np.atleast_2d(U)
+        mean, _ = self.predict(U)
+        return GaussianProcess(np.vstack([self.X, U]), np.concatenate([self.y, mean]), self.theta)
+
+
+def _neg_log_posterior(theta: np.ndarray, X: np.ndarray, y: np.ndarray, prior_mu: float,
+                       w: float) -> tuple[float, np.ndarray]:
+    n, d = X.shape
+    ell, signal, noise = np.exp(theta[:d]), math.exp(theta[d]), math.exp(theta[d + 1])
+    K, W = _matern(X, X, ell, signal)
+    Kf = K.copy()
+    K[np.diag_indices_from(K)] += noise
+    try:
+        L = np.linalg.cholesky(K)
+    except np.linalg.LinAlgError:
+        return 1e10, np.zeros_like(theta)
+    alpha = cho_solve((L, True), y)
+    Kinv = cho_solve((L, True), np.eye(n))
+    nll = 0.5 * y @ alpha + np.sum(np.log(np.diag(L))) + 0.5 * n * math.log(2 * math.pi)
+    A = np.outer(alpha, alpha) - Kinv
+    M = A * W
+    U = X / ell
+    # Σ_ij M_ij (u_ik − u_jk)² without forming the n × n × d differences.
+    grad_ell = -0.5 * (2.0 * np.sum(U * U * M.sum(1)[:, None], 0) - 2.0 * np.sum(U * (M @ U), 0))
+    grad = np.concatenate([grad_ell, [-0.5 * np.sum(A * Kf), -0.5 * noise * np.trace(A)]])
+    # Log-normal prior on the length-scales, variance 3 (weight w: 1 with the prior, 0 for plain ML-II).
+    z = theta[:d] - prior_mu
+    return float(nll + w * np.sum(z * z) / 6.0), grad + w * np.concatenate([z / 3.0, [0.0, 0.0]])
+
+
+def fit_gp(X: np.ndarray, y: np.ndarray, rng: np.random.Generator, warm: np.ndarray | None = None,
+           starts: int = 3, maxiter: int = 100, prior: bool = True) -> GaussianProcess:
+    """Fit the hyperparameters by L-BFGS-B on the log posterior from ``starts`` points and keep the best.
+
+    Parameters
+    ----------
+    X : (n, d) ndarray
+        Designs in the unit cube.
+    y : (n,) ndarray
+        Standardised targets.
+    rng : Generator
+        Draws the random starts (from the prior).
+    warm : ndarray, optional
+        A previous fit's ``theta``, tried first (consecutive fits differ by a design or a few).
+    starts : int
+        Starting points of the optimiser, ``warm`` included.
+    maxiter : int
+        L-BFGS-B iterations per start.
+    prior : bool
+        Maximise the posterior with the length-scale prior (default) or the plain marginal likelihood.
+    """
+    d = X.shape[1]
+    prior_mu = math.sqrt(2.0) + 0.5 * math.log(d)
+    bounds = [_LOG_ELL] * d + [_LOG_SIGNAL, _LOG_NOISE]
+    lo, hi = np.array(bounds).T
+    cands = [] if warm is None else [np.clip(warm, lo, hi)]
+    while len(cands) < max(starts, 1):
+        ell = np.clip(prior_mu + math.sqrt(3.0) * rng.standard_normal(d), *_LOG_ELL)
+        cands.append(np.concatenate([ell, [0.0, math.log(1e-4)]]))
+    best, best_val = cands[0], np.inf
+    for theta0 in cands:
+        res = minimize(_neg_log_posterior, theta0, args=(X, y, prior_mu, float(prior)), jac=True, method="L-BFGS-B",
+                       bounds=bounds, options={"maxiter": maxiter})
+        if res.fun < best_val:
+            best, best_val = res.x, res.fun
+    return GaussianProcess(X, y, best)

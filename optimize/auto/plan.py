@@ -1,0 +1,63 @@
+"""The plan of the default method, chosen from the number of variables and the budget (and said in the result).
+
+* ``global`` (d <= 4): one GP over the whole box, expected-improvement steps, then a local polish on the model
+  around the incumbent for the last tenth of the budget.  In 2 to 4 variables tens of designs cover the box well
+  enough for a global model to find the best basin (EGO, Jones et al. 1998).
+* ``trust-region`` (d >= 5): expected-improvement steps in a trust region around the incumbent, which grows and
+  shrinks with success and restarts at the global model's most promising point when it collapses (TuRBO, Eriksson
+  et al. 2019); the last tenth of the budget minimises the local model's mean around the best design of any
+  restart (a final polish).
+
+Both start from a scrambled Sobol design of 2d + 2 points (fewer when the budget is short, so that at least a
+quarter of it is left to the model): the smallest design that fixes a length-scale per variable with some margin.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+__all__ = ["Plan", "choose_plan", "min_budget"]
+
+#: Largest number of variables for which one global GP is used.
+GLOBAL_MAX_DIM = 4
+
+
+def min_budget(dim: int) -> int:
+    """The fewest simulations the default method accepts: 2d + 2."""
+    return 2 * dim + 2
+
+
+@dataclass(frozen=True)
+class Plan:
+    """What the default method will do.
+
+    Attributes
+    ----------
+    name : str
+        ``"global"`` or ``"trust-region"``.
+    n_init : int
+        Space-filling designs simulated first.
+    n_polish : int
+        Last simulations spent on the local polish (global plan).
+    batch : int
+        Designs proposed per step.
+    """
+
+    name: str
+    n_init: int
+    n_polish: int
+    batch: int
+
+    def describe(self, dim: int, budget: int) -> str:
+        """One line for the result's message."""
+        what = ("one global GP, expected improvement" if self.name == "global"
+                else "expected improvement in a restarted trust region")
+        what += f", local polish of the last {self.n_polish}"
+        return f"plan {self.name} (d = {dim}, budget {budget}): {self.n_init} Sobol designs, then {what}"
+
+
+def choose_plan(dim: int, budget: int, batch: int = 1) -> Plan:
+    """The plan for ``dim`` variables and ``budget`` simulations, ``batch`` designs a step."""
+    n_init = min(2 * dim + 2, budget - max(1, budget // 4))
+    n_polish = max(1, budget // 10) if budget - n_init > 2 else 0
+    return Plan("global" if dim <= GLOBAL_MAX_DIM else "trust-region", n_init, n_polish, batch)

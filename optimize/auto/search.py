@@ -1,0 +1,296 @@
+"""The default method of :func:`mechopt.minimize`: Gaussian-process steps on a plan chosen by dimension and budget
+(:mod:`mechopt.optimize.auto.plan`), failed simulations learned as a hidden constraint.
+
+Every phase proposes ``batch`` designs at once (the kriging believer), so that parallel workers can simulate a
+step together; the budget is spent exactly, on distinct designs only.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.spatial import cKDTree
+from scipy.stats import qmc
+
+from mechopt.optimize.auto.acquisition import propose_batch
+from mechopt.optimize.auto.feasibility import SuccessModel
+from mechopt.optimize.auto.gp import GaussianProcess, fit_gp
+from mechopt.optimize.auto.plan import Plan, choose_plan
+from mechopt.optimize.auto.polish import polish_on_constraints
+from mechopt.optimize.auto.transform import standardise
+from mechopt.optimize.auto.trust_region import TrustRegion
+
+__all__ = ["AutoResult", "auto_search"]
+
+#: ``evaluate(X) -> (n,)``: objective at designs X (n, d) in the variables' units; NaN where a simulation failed.
+BatchEvaluator = Callable[[np.ndarray], np.ndarray]
+#: ``feasible(X) -> bool (n,)``: designs satisfying the declared (cheap) constraints.
+Predicate = Callable[[np.ndarray], np.ndarray]
+
+#: Designs nearest the trust region's centre that its local GP is fitted to (bounds the cubic cost of a fit).
+LOCAL_POINTS = 150
+#: Edge of the polish box of the global plan, before the length-scale stretch (unit cube).
+POLISH_LENGTH = 0.2
+#: Exploration weight of the polish's lower confidence bound (in standard deviations of the model).
+POLISH_KAPPA = 1.0
+
+
+@dataclass
+class AutoResult:
+    """What the default method found.
+
+    Attributes
+    ----------
+    x : (d,) ndarray
+        Best design simulated successfully (NaN if none).
+    fun : float
+        Its objective.
+    nfev, nfailed : int
+        Simulations spent and those that failed.
+    plan : Plan
+        The plan followed.
+    message : str
+        One line: the plan and how the run ended.
+    X, values : ndarray
+        Every design simulated (n, d) and its value (NaN: failed).
+    """
+
+    x: np.ndarray
+    fun: float
+    nfev: int
+    nfailed: int
+    plan: Plan
+    message: str
+    X: np.ndarray = field(repr=False)
+    values: np.ndarray = field(repr=False)
+
+
+class _Run:
+    """The designs simulated so far (unit cube), the door to the simulator and the model fits."""
+
+    def __init__(self, evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, feasible: Predicate | None,
+                 rng: np.random.Generator, margins: Callable[[np.ndarray], np.ndarray] | None = None) -> None:
+        self.evaluate, self.budget, self.feasible, self.rng = evaluate, budget, feasible, rng
+        self.margins = margins
+        self.lo, self.width = bounds[:, 0], bounds[:, 1] - bounds[:, 0]
+        self.U = np.zeros((0, bounds.shape[0]))
+        self.values = np.zeros(0)
+        self.theta: np.ndarray | None = None
+        self._tree: cKDTree | None = None
+        #: Local models (trust-region plan): the length-scale prior of :mod:`~mechopt.optimize.auto.gp` and the
+        #: compressed upper tail of :mod:`~mechopt.optimize.auto.transform`; a global model has neither.
+        self.prior = False
+        self.n_full_fit = 0
+
+    @property
+    def remaining(self) -> int:
+        return self.budget - self.values.size
+
+    @property
+    def ok(self) -> np.ndarray:
+        return np.isfinite(self.values)
+
+    def to_x(self, U: np.ndarray) -> np.ndarray:
+        return self.lo + np.clip(U, 0.0, 1.0) * self.width
+
+    def allowed(self, U: np.ndarray) -> np.ndarray:
+        """Designs not simulated yet that satisfy the declared constraints."""
+        U = np.atleast_2d(U)
+        fresh = np.ones(U.shape[0], dtype=bool)
+        if self.U.shape[0]:
+            if self._tree is None or self._tree.n != self.U.shape[0]:
+                self._tree = cKDTree(self.U)
+            fresh = self._tree.query(U, p=np.inf, distance_upper_bound=1e-6)[0] > 1e-6
+        if self.feasible is not None and fresh.any():
+            fresh[fresh] = self.feasible(self.to_x(U[fresh]))
+        return fresh
+
+    def simulate(self, U: np.ndarray) -> None:
+        U = np.atleast_2d(U)[: self.remaining]
+        if U.shape[0]:
+            values = np.asarray(self.evaluate(self.to_x(U)), dtype=float).reshape(-1)
+            self.U, self.values = np.vstack([self.U, U]), np.concatenate([self.values, values])
+
+    def fill(self, U: np.ndarray, k: int) -> np.ndarray:
+        """``U`` topped up to ``k`` designs with allowed random ones (a proposal found too few in its box)."""
+        tries = 0
+        while U.shape[0] < k and tries < 50:
+            C = self.rng.random((64, U.shape[1]))
+            C = C[self.allowed(C)]
+            U, tries = np.vstack([U, C[: k - U.shape[0]]]), tries + 1
+        return U
+
+    def best_index(self) -> int:
+        return int(np.nanargmin(np.where(self.ok, self.values, np.inf)))
+
+    def fit(self, idx: np.ndarray | None = None) -> tuple[GaussianProcess, float]:
+        """GP of the standardised values (of ``idx``, default all) and the incumbent's target.
+
+        A failed design enters at the worst value that succeeded: the model then expects nothing better next to a
+        failure and the expected improvement there drops (the success model only scales it).
+        """
+        idx = np.arange(self.values.size) if idx is None else idx
+        values = self.values[idx]
+        worst = np.nanmax(values) if np.isfinite(values).any() else np.nanmax(self.values)
+        y = standardise(np.where(np.isfinite(values), values, worst), compress_tail=self.prior)
+        full = self.theta is None or idx.size >= 1.25 * self.n_full_fit
+        if full:
+            self.n_full_fit = idx.size
+        gp = fit_gp(self.U[idx], y, self.rng, warm=self.theta, starts=3 if full else 1, maxiter=100 if full else 30,
+                    prior=self.prior)
+        self.theta = gp.theta
+        return gp, float(y.min())
+
+    def success_model(self, gp: GaussianProcess) -> Callable[[np.ndarray], np.ndarray] | None:
+        if self.ok.all():
+            return None
+        return SuccessModel(self.U, self.ok, gp.theta[: self.U.shape[1]]).log_probability
+
+
+def _initial_design(run: _Run, n: int) -> np.ndarray:
+    """The first ``n`` allowed points of a scrambled Sobol sequence (rejection of the declared constraints)."""
+    d = run.U.shape[1]
+    sobol = qmc.Sobol(d, seed=run.rng)
+    chosen = np.zeros((0, d))
+    for _ in range(20):
+        C = sobol.random(max(8, 2 ** int(np.ceil(np.log2(4 * n)))))
+        chosen = np.vstack([chosen, C[run.allowed(C)]])
+        if chosen.shape[0] >= n:
+            break
+    return run.fill(chosen[:n], n)
+
+
+def _global_plan(run: _Run, plan: Plan) -> None:
+    d = run.U.shape[1]
+    ones, zeros = np.ones(d), np.zeros(d)
+    while run.remaining > 0:
+        k = min(plan.batch, run.remaining)
+        gp, best = run.fit()
+        centre = run.U[run.best_index()]
+        lo, hi, kappa, first = zeros, ones, None, np.zeros((0, d))
+        if run.remaining <= plan.n_polish:
+            lo, hi = TrustRegion(d, length=POLISH_LENGTH).box(centre, gp.theta[:d])
+            kappa = POLISH_KAPPA
+            if run.margins is not None:
+                x = polish_on_constraints(gp, centre, lo, hi, lambda U: run.margins(run.to_x(U)), run.allowed)
+                first = first if x is None else x[None, :]
+        if first.shape[0] < k:
+            U = propose_batch(gp, best, lo, hi, centre, k - first.shape[0], run.rng,
+                              lambda C, taken=first: run.allowed(C) & _apart(C, taken), run.success_model(gp),
+                              kappa=kappa)
+            first = np.vstack([first, U])
+        run.simulate(run.fill(first, k))
+
+
+def _apart(U: np.ndarray, chosen: np.ndarray) -> np.ndarray:
+    """Designs U farther than 1e-6 from every design already chosen this step."""
+    if not chosen.shape[0]:
+        return np.ones(U.shape[0], dtype=bool)
+    return np.min(np.max(np.abs(U[:, None, :] - chosen[None, :, :]), axis=2), axis=1) > 1e-6
+
+
+def _local_indices(run: _Run, centre: np.ndarray) -> np.ndarray:
+    dist = np.linalg.norm(run.U - centre, axis=1)
+    return np.argsort(dist)[:LOCAL_POINTS]
+
+
+def _restart_centre(run: _Run) -> np.ndarray:
+    """The design of largest expected improvement over the whole box under a GP of every design."""
+    d = run.U.shape[1]
+    saved, run.theta = run.theta, None
+    gp, best = run.fit(_local_indices(run, run.U[run.best_index()]) if run.ok.sum() > 2 * LOCAL_POINTS else None)
+    run.theta = saved
+    U = propose_batch(gp, best, np.zeros(d), np.ones(d), run.U[run.best_index()], 1, run.rng, run.allowed,
+                      run.success_model(gp))
+    return run.fill(U, 1)
+
+
+def _trust_region_plan(run: _Run, plan: Plan) -> None:
+    d = run.U.shape[1]
+    tr = TrustRegion(d, batch=plan.batch)
+    members = list(range(run.values.size))  # designs of the current restart: its centre is their best
+    while run.remaining > 0:
+        k = min(plan.batch, run.remaining)
+        vals = np.where(run.ok[members], run.values[members], np.inf)
+        centre_i = members[int(np.argmin(vals))]
+        gp, best = run.fit(_local_indices(run, run.U[centre_i]))
+        lo, hi = tr.box(run.U[centre_i], gp.theta[:d])
+        kappa = None
+        if run.remaining <= plan.n_polish:
+            # The last steps refine the best design found by any restart, on the model's mean.
+            centre_i = run.best_index()
+            gp, best = run.fit(_local_indices(run, run.U[centre_i]))
+            lo, hi = TrustRegion(d, length=min(tr.length, POLISH_LENGTH)).box(run.U[centre_i], gp.theta[:d])
+            kappa = 0.0
+        U = propose_batch(gp, best, lo, hi, run.U[centre_i], k, run.rng, run.allowed, run.success_model(gp),
+                          kappa=kappa)
+        before, n0 = vals.min(), run.values.size
+        run.simulate(run.fill(U, k))
+        members += list(range(n0, run.values.size))
+        new = run.values[n0:]
+        new = new[np.isfinite(new)]
+        tr.update(bool(new.size) and new.min() < before - 1e-3 * abs(before))
+        if tr.collapsed and run.remaining > 0:
+            tr.restart()
+            n0 = run.values.size
+            run.simulate(_restart_centre(run))
+            members = list(range(n0, run.values.size))
+
+
+def _limited_threads() -> contextlib.AbstractContextManager:
+    """One BLAS thread: the GP's matrices are small, and threads fight with the simulations for the cores."""
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:
+        return contextlib.nullcontext()
+    return threadpool_limits(1)
+
+
+def auto_search(evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, seed: int = 0,
+                feasible: Predicate | None = None, batch: int = 1,
+                margins: Callable[[np.ndarray], np.ndarray] | None = None) -> AutoResult:
+    """Minimise a simulator within ``budget`` simulations on the plan of :func:`choose_plan`.
+
+    Parameters
+    ----------
+    evaluate : callable
+        ``evaluate(X) -> (n,)`` at designs X (n, d) in the variables' units; NaN where a simulation failed.
+    bounds : (d, 2) array_like
+        Lower and upper bound of each variable.
+    budget : int
+        Simulations to spend (all of them, on distinct designs).
+    seed : int
+        Seed of every random choice.
+    feasible : callable, optional
+        Declared constraints: designs where it is False are never simulated.
+    batch : int
+        Designs proposed per step (simulated together).
+    margins : callable, optional
+        ``margins(X) -> (n, c)``: the declared constraints' margins (>= 0 feasible), for the final polish onto an
+        active constraint.
+
+    Returns
+    -------
+    AutoResult
+    """
+    bounds = np.asarray(bounds, dtype=float)
+    d = bounds.shape[0]
+    plan = choose_plan(d, int(budget), int(batch))
+    run = _Run(evaluate, bounds, int(budget), feasible, np.random.default_rng(seed), margins)
+    run.prior = plan.name == "trust-region"
+    with _limited_threads():
+        run.simulate(_initial_design(run, plan.n_init))
+        if run.ok.sum() < 2:
+            run.simulate(_initial_design(run, run.remaining))
+        (_global_plan if plan.name == "global" else _trust_region_plan)(run, plan)
+    nfailed = int((~run.ok).sum())
+    if run.ok.any():
+        i = run.best_index()
+        x, fun = run.to_x(run.U[i]), float(run.values[i])
+    else:
+        x, fun = np.full(d, np.nan), float("nan")
+    message = f"{plan.describe(d, int(budget))}; {run.values.size} simulations, {nfailed} failed"
+    return AutoResult(x, fun, int(run.values.size), nfailed, plan, message, run.to_x(run.U), run.values)

@@ -1,0 +1,72 @@
+"""The command line lists what mechopt ships, chooses a method, and refuses what the API refuses, with the API's
+own one-line messages."""
+
+import json
+
+import pytest
+
+import mechopt
+from mechopt.cli.main import EXIT_ERROR, main
+from mechopt.errors import InputError
+from mechopt.optimize.arguments import available_methods
+from mechopt.studies.catalogue import available_studies
+from mechopt.studies.test_functions import Hartmann3
+
+
+def test_version(capsys):
+    with pytest.raises(SystemExit) as stop:
+        main(["--version"])
+    assert stop.value.code == 0
+    assert capsys.readouterr().out.strip() == f"mechopt {mechopt.__version__}"
+
+
+def test_studies_lists_every_study_and_test_function_with_a_description(capsys):
+    assert main(["studies"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    listed = {line.split()[0]: line for line in lines if line.strip() and not line.startswith("run one")}
+    assert set(listed) == set(available_studies())
+    assert "four-bar, 3 variables: Emergency ventilator" in listed["ventilator"]
+    assert "test function, 3 variables: Hartmann-3" in listed["hartmann3"]
+
+
+def test_methods_lists_every_method(capsys):
+    assert main(["methods"]) == 0
+    out = capsys.readouterr().out
+    names = [line.split()[0] for line in out.splitlines() if line.strip() and not line.startswith("choose")]
+    assert names == available_methods()
+    assert all(len(line.split(None, 1)) == 2 for line in out.splitlines()[: len(names)])  # each has a description
+
+
+def test_study_runs_a_chosen_method(tmp_path, capsys):
+    out = tmp_path / "h3"
+    assert main(["study", "hartmann3", "--method", "differential_evolution", "--budget", "40", "--lines", "0",
+                 "--workers", "1", "--no-progress", "--out", str(out)]) == 0
+    result = json.loads((out / "result.json").read_text())
+    assert result["problem"]["method"] == "differential_evolution"
+    assert result["simulations"]["optimisation"] == 40
+    assert result["optimum"]["predicted"] is None  # no line model behind this method
+    # The same call through the API gives the same answer (same seed, same budget).
+    api = mechopt.minimize(Hartmann3(), budget=40, method="differential_evolution", seed=0)
+    assert result["optimum"]["objective"] == pytest.approx(api.fun, rel=0, abs=0)
+    assert "method differential_evolution" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(("argv", "call"), [
+    (["--budget", "1"], {"budget": 1}),
+    (["--method", "no_such_method"], {"method": "no_such_method"}),
+])
+def test_cli_and_api_refuse_the_same_arguments_with_the_same_message(tmp_path, capsys, argv, call):
+    code = main(["study", "hartmann3", "--lines", "0", "--no-progress", "--out", str(tmp_path / "x"), *argv])
+    assert code == EXIT_ERROR
+    cli_message = capsys.readouterr().err.strip().removeprefix("mechopt: error: ")
+    with pytest.raises(InputError) as api:
+        mechopt.minimize(Hartmann3(), **{"budget": 30, **call})
+    assert cli_message == str(api.value)
+    assert not (tmp_path / "x" / "samples.sqlite").exists()  # refused before any simulation
+
+
+def test_a_line_model_method_refuses_more_than_four_variables_in_cli_terms():
+    from mechopt.optimize.arguments import check_method
+
+    with pytest.raises(InputError, match="handles 2 to 4 design variables; 'p6' has 6"):
+        check_method("sparse", 6, "p6")

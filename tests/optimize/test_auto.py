@@ -1,0 +1,114 @@
+"""The default method ``auto`` (mechopt.optimize.auto): plan, budget, failures, convergence, refusals."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import approx_fprime
+
+from mechopt import minimize
+from mechopt.errors import InputError
+from mechopt.optimize.auto import auto_search, choose_plan
+from mechopt.optimize.auto.gp import _neg_log_posterior, fit_gp
+from mechopt.optimize.problem import DesignProblem, Variable
+from mechopt.studies.test_functions import FailingHartmann3, Hartmann3, Hartmann6
+
+
+class Quadratic(DesignProblem):
+    """(x − c)ᵀ A (x − c) + 2 with a known minimiser c inside the box and a tilted, anisotropic A."""
+
+    name = "quadratic"
+    variables = (Variable("a", -1.0, 3.0), Variable("b", 0.0, 2.0), Variable("c", -2.0, 2.0))
+    outputs = ("f",)
+    objective = "f"
+    centre = np.array([1.3, 0.4, -0.7])
+    A = np.array([[3.0, 1.0, 0.0], [1.0, 2.0, 0.5], [0.0, 0.5, 1.0]])
+
+    def evaluate(self, x):
+        t = np.asarray(x) - self.centre
+        return {"f": float(t @ self.A @ t + 2.0)}
+
+
+def test_default_method_is_auto_and_says_its_plan():
+    r = minimize(Hartmann3(), 12, seed=1)
+    assert r.method == "auto" and r.plan == "global"
+    assert "plan global" in r.message and r.nfev == 12
+
+
+def test_plan_follows_dimension_and_budget():
+    assert choose_plan(3, 30).name == "global"
+    assert choose_plan(6, 300).name == "trust-region"
+    # The initial design leaves at least a quarter of a short budget to the model.
+    short = choose_plan(6, 14)
+    assert short.n_init <= 14 - 3 and choose_plan(6, 300).n_init == 14
+
+
+def test_hartmann3_global_basin_at_30():
+    p = Hartmann3()
+    r = minimize(p, 30, seed=0)
+    assert r.nfev == 30
+    assert p.in_global_basin(r.x)
+    assert p.gap(r.fun) < 0.01
+
+
+def test_quadratic_closed_form_minimum():
+    p = Quadratic()
+    r = minimize(p, 30, seed=3)
+    np.testing.assert_allclose(r.x, p.centre, atol=0.02)
+    assert r.fun == pytest.approx(2.0, abs=1e-3)
+
+
+def test_6d_small_budget_spends_exactly_its_budget():
+    r = minimize(Hartmann6(), 20, seed=0)
+    assert r.plan == "trust-region" and r.nfev == 20 and r.success
+    assert r.fun < -0.5  # better than a typical random design (the mean of Hartmann-6 over the box is about −0.26)
+
+
+def test_batches_spend_exactly_the_budget_on_distinct_designs():
+    p = Hartmann3()
+    res = auto_search(p, p.bounds, 17, seed=2, batch=3)
+    assert res.nfev == 17 and res.X.shape == (17, 3)
+    assert np.unique(np.round(res.X, 9), axis=0).shape[0] == 17
+
+
+def test_runs_in_12_dimensions():
+    def sphere(X):
+        return np.sum((np.atleast_2d(X) - 0.3) ** 2, axis=1)
+
+    bounds = np.array([[-1.0, 1.0]] * 12)
+    res = auto_search(sphere, bounds, 60, seed=0)
+    assert res.nfev == 60 and res.plan.name == "trust-region"
+    assert res.fun < np.min(res.values[: res.plan.n_init])  # the model's steps improved on the initial design
+
+
+def test_failure_region_is_learned_not_raised():
+    p = FailingHartmann3()
+    r = minimize(p, 40, seed=0)
+    assert r.success and r.nfev == 40
+    assert r.x[0] <= p.raise_above and r.x[1] <= p.nan_above
+    assert 0 < r.nfailed < 20  # failures happen (a fifth of the box fails) and are counted, and then avoided
+    assert f"{r.nfailed} failed" in r.message
+
+
+def test_budget_below_2d_plus_2_refused_in_one_line():
+    with pytest.raises(InputError) as info:
+        minimize(Hartmann6(), 13)
+    assert "2d + 2 = 14" in str(info.value) and "\n" not in str(info.value)
+
+
+def test_gp_gradient_and_fit():
+    rng = np.random.default_rng(0)
+    X = rng.random((25, 3))
+    y = np.sin(6 * X[:, 0]) + X[:, 1] ** 2
+    y = (y - y.mean()) / y.std()
+    theta = np.array([-1.0, -0.3, 0.5, 0.2, np.log(1e-3)])
+    for w in (0.0, 1.0):
+        grad = _neg_log_posterior(theta, X, y, 1.9, w)[1]
+        fd = approx_fprime(theta, lambda t, w=w: _neg_log_posterior(t, X, y, 1.9, w)[0], 1e-6)
+        np.testing.assert_allclose(grad, fd, rtol=1e-4, atol=1e-4)
+    gp = fit_gp(X, y, rng)
+    mean, sd = gp.predict(X)
+    np.testing.assert_allclose(mean, y, atol=0.05)  # a near-noiseless function is interpolated
+    assert np.all(sd < 0.1)
+    # x3 does not enter y: its length-scale is the longest.
+    assert np.argmax(gp.theta[:3]) == 2

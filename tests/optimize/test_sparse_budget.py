@@ -1,0 +1,81 @@
+"""The budget is the cost (issue 25): the lines keep a share for refinement, the default validation is a stated
+share on top, and a larger budget never gives a worse answer on the suite functions."""
+
+from __future__ import annotations
+
+import pytest
+
+import mechopt
+from mechopt.cli.study_options import study_options
+from mechopt.optimize.sparse.options import LINE_SHARE, SparseOptions
+from mechopt.studies.catalogue import load_study
+from mechopt.studies.test_functions import SUITE
+
+
+@pytest.mark.parametrize("budget", [3, 10, 60, 150, 300, 599, 600, 2000])
+def test_the_lines_always_leave_a_share_of_the_budget_to_refine(budget):
+    opts = SparseOptions.for_budget(budget, 3)
+    assert opts.line_cap() <= max(2, LINE_SHARE * budget) and opts.line_cap() < budget
+    planned = opts.n_lines * opts.samples_per_line
+    if budget >= 60:
+        # The scaled plan itself fits the lines' share: trimming is for plans a user forced.
+        assert planned <= opts.line_cap(), (budget, planned)
+
+
+@pytest.mark.parametrize(("given", "expected"), [
+    ({"budget": 60}, (2, 6)),                      # 12 = 20 % of 60: two directions of 6 points
+    ({"budget": 150}, (5, 6)),                     # 30
+    ({"budget": 600}, (10, 12)),                   # 120, the ventilator's default
+    ({"budget": 600, "validation_budget": 300}, (10, 30)),  # the full validation of earlier versions, on request
+    ({"budget": 600, "validation_budget": 5000}, (10, 30)),  # never more than lines x points
+    ({"budget": 600, "validation_lines": 0}, (0, 0)),        # --lines 0: none
+    ({"budget": 600, "validation_budget": 0}, (0, 0)),       # --validation 0: none
+    ({"budget": 20}, (0, 0)),                      # 4 points cannot make a held-out line of 6
+])
+def test_default_validation_is_a_fifth_of_the_budget_on_top(given, expected):
+    opts = SparseOptions(given)
+    n_lines, per_line = opts.validation_plan()
+    assert (n_lines, per_line) == expected
+    if "validation_budget" not in given:
+        assert n_lines * per_line <= 0.2 * opts.budget
+
+
+def test_a_study_plan_that_does_not_fit_the_budget_is_scaled_and_said():
+    study = load_study("ventilator", {"engine": "analytic"})
+    told: list[str] = []
+    small = study_options(study, {"budget": 150}, log=told.append)
+    # 21 lines of 25 would take 525 > 150: the plan of for_budget, and the user hears why.
+    assert (small.n_lines, small.samples_per_line) == (3, 4) and len(told) == 1 and "21 lines x 25" in told[0]
+    own = study_options(study, {}, log=told.append)
+    assert (own.n_lines, own.samples_per_line, own.budget, own.search_points) == (21, 25, 600, 10_000_000)
+    forced = study_options(study, {"budget": 150, "n_lines": 9}, log=told.append)
+    assert forced.n_lines == 9 and len(told) == 1  # the user's own plan is kept (and trimmed to the cap)
+
+
+#: The suite's functions the line model takes (2 to 4 variables).  failing_hartmann3 is left out: at 60 two of the
+#: three lines of the small plan cross its failing region and no model can be made (a one-line error, tested below).
+SPARSE_SUITE = sorted(name for name, cls in SUITE.items() if 2 <= cls().dim <= 4 and name != "failing_hartmann3")
+
+
+@pytest.mark.parametrize("name", SPARSE_SUITE)
+def test_more_budget_is_never_worse_on_the_suite(name):
+    # The path of `mechopt study NAME --budget B`: the study's options scaled to the budget, same seed.
+    study = load_study(name)
+    answers = []
+    for budget in (60, 150, 300):
+        # No held-out lines: they are on top of the budget and do not change the answer.
+        options = study_options(study, {"budget": budget, "seed": 0, "validation_lines": 0})
+        res = mechopt.minimize(study.problem, budget=budget, seed=0, options=options, method="sparse")
+        assert res.nfev <= budget
+        answers.append(res.fun)
+    # "Not worse" up to where the local search stops: two budgets that find the same minimum may stop 1e-10 apart
+    # (cosine_bowl4: 2e-10; styblinski_tang3: 5e-8 of a range of 250), far below any difference of minima.
+    tol = 1e-6 * study.problem.f_range
+    assert answers[1] <= answers[0] + tol and answers[2] <= answers[1] + tol, answers
+
+
+def test_lines_lost_to_a_failing_simulator_are_one_clear_error():
+    study = load_study("failing_hartmann3")
+    options = study_options(study, {"budget": 60, "seed": 0, "validation_lines": 0})
+    with pytest.raises(mechopt.MechoptError, match=r"of the 3 lines of the global model failed to simulate"):
+        mechopt.minimize(study.problem, budget=60, seed=0, options=options, method="sparse")
