@@ -21,15 +21,16 @@ def main() -> None:
     parser.add_argument("runs", nargs="+", type=Path, help="compare.json files")
     parser.add_argument("--out", type=Path, default=Path("."), help="folder of headline.md and the figure")
     args = parser.parse_args()
-    needed, budgets = {}, {}
+    needed, budgets, unfinished = {}, {}, {}
     for path in args.runs:
         data = json.loads(path.read_text())
         needed[data["study"]] = data["needed"]
+        unfinished[data["study"]] = set(data.get("unfinished_methods", []))
         budgets[data["study"]] = {m: max(r["budget"] for r in data["rows"] if r["method"] == m) for m in data["needed"]}
     args.out.mkdir(parents=True, exist_ok=True)
-    text = headline(needed, budgets)
+    text = headline(needed, budgets, unfinished)
     (args.out / "headline.md").write_text(text)
-    fig = plot_headline(needed, budgets, args.out / "compare_headline.png")
+    fig = plot_headline(needed, budgets, args.out / "compare_headline.png", unfinished)
     print(text)
     print(f"written: {args.out / 'headline.md'}, {fig}")
 

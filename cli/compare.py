@@ -38,10 +38,17 @@ from mechopt.surrogate.errors import SurrogateError
 #: Bayesian optimisation (in-house GP, SMT's EGO) refits a Gaussian process on all samples at every step (cubic
 #: cost): it is run up to this budget only, as in the literature, where it is used for small budgets.
 BAYESIAN_MAX_BUDGET = 200
-#: SMT's EGO refits its Kriging model with a hyperparameter search at every step, a cost that grows with the cube of
-#: the simulations: compare runs it up to this budget, where a step stays under a few seconds (measured by
-#: benchmarks/bench_peer_budgets.py, see BENCHMARKS.md), and refuses a larger one it is explicitly asked for.
+#: SMT's EGO refits its Kriging model (a hyperparameter search per variable) at every step, a cost that grows with the
+#: cube of the simulations and with the dimension: compare runs it up to the budget where a step still takes under
+#: about 3 s of CPU, and refuses a larger one it is explicitly asked for.  CPU time per step, one BLAS thread, on
+#: the 2-core machine under heavy load (2026-11-25): 3-D 1.0 s at 20 samples, 2.5 s at 100, 3.1 s at 120, 4.3 s at
+#: 140; 5-D 1.5 s at 30, 2.4 s at 60, 3.2 s at 70; 8-D 1.7 s at 20, 3.2 s at 30, 3.9 s at 40.  Less loaded
+#: (benchmarks/bench_peer_budgets.py, BENCHMARKS.md): 3-D 1.8 s at 100, 8-D 2.4 s at 30.  The limit up to 3
+#: variables:
 EGO_MAX_BUDGET = 100
+#: The limits as (most variables, largest budget): 100 up to 3 variables, 60 at 4 or 5, 30 from 6 on (measured at
+#: 3, 5 and 8 variables; beyond 8 a step at 30 samples is not measured and may cost more).
+EGO_MAX_BUDGETS = ((3, EGO_MAX_BUDGET), (5, 60), (12, 30))
 #: The peers from maintained libraries: each asks for designs until the budget is spent (a test per peer checks
 #: ``nfev == budget``), so a run of one of them that ends with simulations left was stopped by an error or a defect,
 #: never by a rule of its own.
@@ -129,10 +136,8 @@ def gap_pct(problem: DesignProblem, truth: GroundTruth, value: float) -> float:
 
 @dataclass
 class _Outcome:
-    """What a guarded baseline run left behind: the simulations spent and the error that stopped it, if any."""
+    """What a guarded baseline run left behind: the error that stopped it, if any."""
 
-    nfev: int = 0
-    budget: int = 0
     error: str = ""
 
 
@@ -146,13 +151,12 @@ def _one_line(exc: BaseException, limit: int = 200) -> str:
 def _guarded(name: str, fn: Callable[..., OptimizeResult], outcome: _Outcome) -> Callable[..., OptimizeResult]:
     """The baseline ``fn`` as a :func:`minimize` method that never lets an error end the comparison.
 
-    An exception of the method (a library's defect, a missing package) is recorded in ``outcome`` with the
-    simulations spent until then, and the best design so far is returned; ``mechopt compare`` then marks the run as
+    An exception of the method (a library's defect, a missing package) is recorded in ``outcome`` and the best
+    design simulated until then is returned; ``mechopt compare`` then marks the run as
     unfinished.  Running the callable through :func:`minimize` is the same as running the method by its name.
     """
 
     def method(problem: CountedProblem, seed: int) -> OptimizeResult:
-        outcome.budget = problem.budget
         try:
             res = fn(problem, seed)
         except BudgetExhausted as exc:  # a wrapper that let the budget's end through: the budget is spent
@@ -162,27 +166,48 @@ def _guarded(name: str, fn: Callable[..., OptimizeResult], outcome: _Outcome) ->
         except Exception as exc:  # any error of a peer is a result to report, not a crash of the comparison
             outcome.error = _one_line(exc)
             res = problem.result(f"{name} raised after {problem.nfev} simulations: {outcome.error}")
-        outcome.nfev = problem.nfev
         return res
 
     method.__name__ = name
     return method
 
 
-def method_caps(gp_max_budget: int | None = None) -> dict[str, int]:
-    """Largest budget of the methods that have one (the Gaussian-process methods), lowered by ``gp_max_budget``."""
-    caps = {"bayesian": BAYESIAN_MAX_BUDGET, "smt_ego": EGO_MAX_BUDGET}
+def ego_max_budget(dim: int) -> int:
+    """The largest budget ``mechopt compare`` runs SMT's EGO at on a problem of ``dim`` variables (see
+    :data:`EGO_MAX_BUDGETS`)."""
+    for most, budget in EGO_MAX_BUDGETS:
+        if dim <= most:
+            return budget
+    return EGO_MAX_BUDGETS[-1][1]
+
+
+def method_caps(gp_max_budget: int | None = None, dim: int = 3) -> dict[str, int]:
+    """Largest budget of the methods that have one (the Gaussian-process methods) at ``dim`` variables, lowered by
+    ``gp_max_budget``."""
+    caps = {"bayesian": BAYESIAN_MAX_BUDGET, "smt_ego": ego_max_budget(dim)}
     if gp_max_budget is not None:
         caps = {k: min(v, int(gp_max_budget)) for k, v in caps.items()}
     return caps
 
 
-def check_limits(methods: list[str] | None, budgets: Iterable[int], gp_max_budget: int | None = None) -> None:
-    """Refuse, before any run, SMT's EGO named in ``methods`` at a budget beyond :data:`EGO_MAX_BUDGET`.
+def check_limits(methods: list[str] | None, budgets: Iterable[int], gp_max_budget: int | None = None,
+                 dims: Iterable[int] = (3,)) -> None:
+    """Refuse, before any run, SMT's EGO named in ``methods`` at a budget beyond its limit (:func:`ego_max_budget`).
 
-    Beyond it an EGO step (a Kriging refit on every sample) takes more than a few seconds.  A ``gp_max_budget`` at
+    Beyond it an EGO step (a Kriging refit on every sample) takes more than about 3 s.  A ``gp_max_budget`` at
     or below the limit asks for EGO to be run only up to it, so larger budgets are then skipped for EGO instead;
     when EGO is not named (every method), it is skipped beyond its limit and :func:`compare` says so.
+
+    Parameters
+    ----------
+    methods : list of str, optional
+        The methods asked for (None: every method).
+    budgets : iterable of int
+        The budgets asked for.
+    gp_max_budget : int, optional
+        ``--gp-max-budget``.
+    dims : iterable of int
+        The numbers of variables of the studies compared.
 
     Raises
     ------
@@ -191,16 +216,20 @@ def check_limits(methods: list[str] | None, budgets: Iterable[int], gp_max_budge
     """
     if not methods or "smt_ego" not in methods:
         return
-    if gp_max_budget is not None and gp_max_budget <= EGO_MAX_BUDGET:
-        return
-    beyond = [b for b in budgets if b > EGO_MAX_BUDGET]
-    if beyond:
-        raise InputError(f"smt_ego at budget {max(beyond)}: beyond its limit of {EGO_MAX_BUDGET} simulations (each "
-                         "EGO step refits Kriging on every sample, seconds a step beyond); lower --budgets or run it "
-                         f"only up to N <= {EGO_MAX_BUDGET} with --gp-max-budget N")
+    budgets = list(budgets)
+    for dim in sorted(set(dims), reverse=True):
+        limit = ego_max_budget(dim)
+        if gp_max_budget is not None and gp_max_budget <= limit:
+            continue
+        beyond = [b for b in budgets if b > limit]
+        if beyond:
+            raise InputError(f"smt_ego at budget {max(beyond)}: beyond its limit of {limit} simulations at {dim} "
+                             "variables (each EGO step refits Kriging on every sample, over 3 s a step beyond); lower "
+                             f"--budgets or run it only up to N <= {limit} with --gp-max-budget N")
 
 
-def check_methods(methods: list[str] | None, budgets: Iterable[int], gp_max_budget: int | None = None) -> list[str]:
+def check_methods(methods: list[str] | None, budgets: Iterable[int], gp_max_budget: int | None = None,
+                  dims: Iterable[int] = (3,)) -> list[str]:
     """The methods to compare, in table order, after refusing an unknown one or EGO beyond its limit.
 
     Parameters
@@ -211,6 +240,8 @@ def check_methods(methods: list[str] | None, budgets: Iterable[int], gp_max_budg
         The budgets asked for.
     gp_max_budget : int, optional
         ``--gp-max-budget``.
+    dims : iterable of int
+        The numbers of variables of the studies compared.
 
     Returns
     -------
@@ -227,7 +258,7 @@ def check_methods(methods: list[str] | None, budgets: Iterable[int], gp_max_budg
         if unknown:
             raise InputError(f"unknown method {unknown[0]!r}; expected some of {', '.join(names)}")
         names = [n for n in names if n in methods]
-    check_limits(methods, budgets, gp_max_budget)
+    check_limits(methods, budgets, gp_max_budget, dims)
     return names
 
 
@@ -252,7 +283,7 @@ def run_one(problem: DesignProblem, truth: GroundTruth, name: str, budget: int, 
         or when a peer of :data:`SPENDS_WHOLE_BUDGET` left simulations unspent (``reason`` says why).
     """
     t0 = time.perf_counter()
-    outcome = _Outcome(budget=budget)
+    outcome = _Outcome()
     message = ""
     try:
         if name in BASELINES:
@@ -288,14 +319,14 @@ def compare(study: Study, truth: GroundTruth, budgets: list[int], seeds: int, me
     InputError
         An unknown method, or SMT's EGO named at a budget beyond its limit (:func:`check_limits`), before any run.
     """
-    names = check_methods(methods, budgets, gp_max_budget)
-    caps = method_caps(gp_max_budget)
+    problem = study.problem
+    names = check_methods(methods, budgets, gp_max_budget, [problem.dim])
+    caps = method_caps(gp_max_budget, problem.dim)
     for name in names:
         skipped = [b for b in budgets if b > caps.get(name, b)]
         if skipped:
             progress(f"  {name} runs up to {caps[name]} simulations: not run at "
                      f"{', '.join(str(b) for b in skipped)}")
-    problem = study.problem
     runs: list[Run] = []
     for budget in budgets:
         for seed in range(seeds):

@@ -26,8 +26,9 @@ def add_parser(sub, engines: tuple[str, ...]) -> None:
     p.add_argument("--out", metavar="DIR", help="output folder (default: STUDY-study)")
     p.add_argument("--truth-grid", type=positive_float, default=1.0, help="grid of the ground truth brute force")
     p.add_argument("--gp-max-budget", type=positive_int, metavar="N",
-                   help="largest budget of the Gaussian-process methods (bayesian, smt_ego; default 200 and 100): "
-                   "they refit at every call and take minutes a run")
+                   help="largest budget of the Gaussian-process methods (bayesian, smt_ego; default 200; "
+                   "smt_ego 100 up to 3 variables, 60 at 4-5, 30 from 6): they refit at every call and take "
+                   "minutes a run")
     p.set_defaults(func=run)
 
 
@@ -52,8 +53,9 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
     names = [n for n in args.study.split(",") if n]
     methods = args.methods.split(",") if args.methods else None
     studies = _studies(args, names)
+    cmp.check_methods(methods, args.budgets, args.gp_max_budget, [s.problem.dim for s in studies])
     base = Path(args.out or (f"{names[0]}-study" if len(names) == 1 else "compare"))
-    needed, budgets = {}, {}
+    needed, budgets, unfinished = {}, {}, {}
     for study in studies:
         out = check_output_folder(base if len(studies) == 1 else base / study.name)
         truth = cmp.known_truth(study.problem) or cmp.declared_truth(study)
@@ -69,10 +71,11 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
         rows = cmp.table(runs, study.problem, truth)
         needed[study.name] = cmp.simulations_needed(rows)
         budgets[study.name] = cmp.largest_budgets(rows)
+        unfinished[study.name] = cmp.unfinished_methods(rows)
     if len(studies) > 1:
-        text = cmp.headline(needed, budgets)
+        text = cmp.headline(needed, budgets, unfinished)
         (base / "headline.md").write_text(text)
-        fig = cmp.plot_headline(needed, budgets, base / "figures" / "compare_headline.png")
+        fig = cmp.plot_headline(needed, budgets, base / "figures" / "compare_headline.png", unfinished)
         print(text)
         print(f"headline written to {base / 'headline.md'}, figure to {fig}")
     return 0

@@ -57,7 +57,7 @@ def _check_arguments(problem: Any, budget: Any, method: Any, seed: Any, workers:
     check_workers(workers)
 
 
-def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[..., Any] = AUTO_METHOD, seed: int = 0,
+def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[..., Any] = "sparse", seed: int = 0,
              workers: int | None = 1, store: str | Path | SampleStore | None = None,
              options: Mapping[str, Any] | SparseOptions | None = None, scheduler: Any = None,
              progress: bool = False, retry_failed: bool = False,
@@ -71,9 +71,10 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
     budget : int
         Most simulations the method may ask for (validation simulations of the sparse method come on top).
     method : str or callable
-        ``"auto"`` (default: Gaussian-process steps on a plan chosen by dimension and budget, failed simulations
-        learned and avoided; needs a budget >= 2d + 2; :mod:`mechopt.optimize.auto`), ``"sparse"`` (the
-        line-sampled sparse model of paper 002, then a local search on the simulator),
+        ``"sparse"`` (default: the line-sampled sparse model of paper 002, then a local search on the simulator;
+        2 to 4 variables), ``"auto"`` (Gaussian-process steps on a plan chosen by dimension and budget, 2 to 12
+        variables, failed simulations learned and avoided; needs a budget >= 2d + 2; :mod:`mechopt.optimize.auto`;
+        the default-to-be, once it meets its benchmarks: see the README),
         ``"sparse-global"`` (for multimodal objectives: the lines' blend, its basins, then steps on the blend
         corrected by every simulation; :mod:`mechopt.optimize.sparse_global`), a
         baseline's name (``"slsqp"``, ``"differential_evolution"``...) or a callable
@@ -109,22 +110,11 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
         A bad argument, before any simulation.
     """
     _check_arguments(problem, budget, method, seed, workers)
-    if isinstance(options, SparseOptions):
-        opts = options.replace(budget=int(budget), seed=int(seed))
-    else:
-        given = dict(options or {})
-        given.setdefault("validation_lines", 0)
-        opts = SparseOptions.for_budget(int(budget), problem.dim, int(seed), **given)
+    opts = _options(problem, options, int(budget), int(seed))
     log = log or (lambda _line: None)
     t0 = time.perf_counter()
     with contextlib.ExitStack() as stack:
-        if isinstance(store, SampleStore):
-            db = store
-        else:
-            if store is None:
-                folder = stack.enter_context(tempfile.TemporaryDirectory(prefix="mechopt-"))
-                store = Path(folder) / "samples.sqlite"
-            db = stack.enter_context(SampleStore(store))
+        db = _open_store(store, stack)
         executor = stack.enter_context(make_executor(workers=workers, scheduler=scheduler))
         sampler = Sampler(problem, db, executor, progress, retry_failed)
         result = run_method(problem, method, opts, sampler, log)
@@ -140,6 +130,25 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
             result["outputs"] = dict(record.outputs)
     result["wall_time_s"] = time.perf_counter() - t0
     return result
+
+
+def _options(problem: DesignProblem, options: Mapping[str, Any] | SparseOptions | None, budget: int,
+             seed: int) -> SparseOptions:
+    """The sparse options of a call: given whole, or scaled to the budget (no held-out lines unless asked)."""
+    if isinstance(options, SparseOptions):
+        return options.replace(budget=budget, seed=seed)
+    given = dict(options or {})
+    given.setdefault("validation_lines", 0)
+    return SparseOptions.for_budget(budget, problem.dim, seed, **given)
+
+
+def _open_store(store: str | Path | SampleStore | None, stack: contextlib.ExitStack) -> SampleStore:
+    """The caller's store, a store at the caller's path, or a temporary one removed when ``stack`` closes."""
+    if isinstance(store, SampleStore):
+        return store
+    if store is None:
+        store = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="mechopt-"))) / "samples.sqlite"
+    return stack.enter_context(SampleStore(store))
 
 
 def run_method(problem: DesignProblem, method: str | Callable[..., Any], opts: SparseOptions, sampler: Sampler,

@@ -96,14 +96,18 @@ class SparseOptions(Options):
         """Held-out lines and points per line of the validation, on top of the budget; (0, 0) for none.
 
         ``validation_budget`` simulations (default :data:`VALIDATION_SHARE` of the budget) spread over at most
-        ``validation_lines`` lines of at least :data:`MIN_HELD_OUT_POINTS` and at most ``validation_points`` points:
-        more directions first, then more points along each.
+        ``validation_lines`` lines of at least :data:`MIN_HELD_OUT_POINTS` (or ``validation_points`` when fewer) and
+        at most ``validation_points`` points: more directions first, then more points along each.
         """
         total = self.validation_budget
         if total is None:
             total = int(VALIDATION_SHARE * self.budget)
         total = min(total, self.validation_lines * self.validation_points)
-        if self.validation_lines <= 0 or total < MIN_HELD_OUT_POINTS:
+        if self.validation_lines <= 0:
             return 0, 0
-        lines = min(self.validation_lines, total // MIN_HELD_OUT_POINTS)
+        # A user who asks for shorter held-out lines (--points-per-line) gets more of them for the same cost.
+        shortest = min(MIN_HELD_OUT_POINTS, self.validation_points)
+        if total < shortest:
+            return 0, 0
+        lines = min(self.validation_lines, total // shortest)
         return lines, min(self.validation_points, total // lines)

@@ -75,7 +75,8 @@ def validation_lines(model: ObjectiveModel, space: ModelSpace, n_lines: int, n_p
     lines: list[np.ndarray] = []
     tries = 0
     extent = float(np.linalg.norm(hi_u - lo_u))
-    while len(lines) < n_lines and tries < 50 * n_lines and len(cloud):
+    # A thin hull (a few lines of the paper's plan) rejects most directions: tries are cheap, no simulation.
+    while len(lines) < n_lines and tries < max(500, 50 * n_lines) and len(cloud):
         tries += 1
         u = rng.standard_normal(d) * (hi_u - lo_u)
         u /= np.linalg.norm(u)

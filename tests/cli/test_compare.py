@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from mechopt.cli.main import EXIT_ERROR, main
+from mechopt.errors import InputError
 
 
 def test_compare_small(tmp_path, capsys):
@@ -153,12 +154,18 @@ def test_the_headline_marks_methods_with_unfinished_runs():
 
 
 def test_smt_ego_beyond_its_limit_is_refused_in_one_line(tmp_path, capsys):
-    from mechopt.cli.compare import EGO_MAX_BUDGET
+    from mechopt.cli.compare import check_methods, ego_max_budget
 
-    too_many = EGO_MAX_BUDGET + 1
+    limit = ego_max_budget(2)  # Branin's 2 variables
     code = main(["compare", "--study", "branin", "--out", str(tmp_path), "--seeds", "1", "--budgets",
-                 f"20,{too_many}", "--methods", "slsqp,smt_ego"])
+                 f"20,{limit + 1}", "--methods", "slsqp,smt_ego"])
     assert code == EXIT_ERROR
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and f"smt_ego at budget {too_many}" in err[0] and f"limit of {EGO_MAX_BUDGET}" in err[0]
+    assert len(err) == 1 and f"smt_ego at budget {limit + 1}" in err[0] and f"limit of {limit} simulations" in err[0]
     assert not (tmp_path / "compare.json").exists()  # refused before any run
+    # The limit falls with the dimension; capping EGO with --gp-max-budget at or below it skips larger budgets.
+    assert ego_max_budget(8) < ego_max_budget(3)
+    with pytest.raises(InputError, match=f"limit of {ego_max_budget(8)} simulations at 8 variables"):
+        check_methods(["smt_ego"], [ego_max_budget(8) + 1], dims=[2, 8])
+    assert check_methods(["smt_ego"], [500], gp_max_budget=ego_max_budget(8), dims=[8]) == ["smt_ego"]
+    assert "smt_ego" in check_methods(None, [500], dims=[8])  # every method: skipped beyond, not refused

@@ -29,8 +29,8 @@ class Quadratic(DesignProblem):
         return {"f": float(t @ self.A @ t + 2.0)}
 
 
-def test_default_method_is_auto_and_says_its_plan():
-    r = minimize(Hartmann3(), 12, seed=1)
+def test_auto_says_its_plan():
+    r = minimize(Hartmann3(), 12, method="auto", seed=1)
     assert r.method == "auto" and r.plan == "global"
     assert "plan global" in r.message and r.nfev == 12
 
@@ -45,7 +45,7 @@ def test_plan_follows_dimension_and_budget():
 
 def test_hartmann3_global_basin_at_30():
     p = Hartmann3()
-    r = minimize(p, 30, seed=0)
+    r = minimize(p, 30, method="auto", seed=0)
     assert r.nfev == 30
     assert p.in_global_basin(r.x)
     assert p.gap(r.fun) < 0.01
@@ -53,13 +53,13 @@ def test_hartmann3_global_basin_at_30():
 
 def test_quadratic_closed_form_minimum():
     p = Quadratic()
-    r = minimize(p, 30, seed=3)
+    r = minimize(p, 30, method="auto", seed=3)
     np.testing.assert_allclose(r.x, p.centre, atol=0.02)
     assert r.fun == pytest.approx(2.0, abs=1e-3)
 
 
 def test_6d_small_budget_spends_exactly_its_budget():
-    r = minimize(Hartmann6(), 20, seed=0)
+    r = minimize(Hartmann6(), 20, method="auto", seed=0)
     assert r.plan == "trust-region" and r.nfev == 20 and r.success
     assert r.fun < -0.5  # better than a typical random design (the mean of Hartmann-6 over the box is about −0.26)
 
@@ -83,7 +83,7 @@ def test_runs_in_12_dimensions():
 
 def test_failure_region_is_learned_not_raised():
     p = FailingHartmann3()
-    r = minimize(p, 40, seed=0)
+    r = minimize(p, 40, method="auto", seed=0)
     assert r.success and r.nfev == 40
     assert r.x[0] <= p.raise_above and r.x[1] <= p.nan_above
     assert 0 < r.nfailed < 20  # failures happen (a fifth of the box fails) and are counted, and then avoided
@@ -92,7 +92,7 @@ def test_failure_region_is_learned_not_raised():
 
 def test_budget_below_2d_plus_2_refused_in_one_line():
     with pytest.raises(InputError) as info:
-        minimize(Hartmann6(), 13)
+        minimize(Hartmann6(), 13, method="auto")
     assert "2d + 2 = 14" in str(info.value) and "\n" not in str(info.value)
 
 

@@ -31,6 +31,7 @@ def test_the_lines_always_leave_a_share_of_the_budget_to_refine(budget):
     ({"budget": 600, "validation_lines": 0}, (0, 0)),        # --lines 0: none
     ({"budget": 600, "validation_budget": 0}, (0, 0)),       # --validation 0: none
     ({"budget": 20}, (0, 0)),                      # 4 points cannot make a held-out line of 6
+    ({"budget": 100, "validation_lines": 2, "validation_points": 5}, (2, 5)),  # shorter lines asked: more of them
 ])
 def test_default_validation_is_a_fifth_of_the_budget_on_top(given, expected):
     opts = SparseOptions(given)
