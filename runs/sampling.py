@@ -25,15 +25,17 @@ import math
 import time
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from mechopt.errors import InfeasibleDesignError, InputError
-from mechopt.optimize.problem import DesignProblem
 from mechopt.runs.cooperative_evaluation import CooperativeEvaluation, is_final
 from mechopt.runs.executors import SampleExecutor
 from mechopt.runs.store import SampleRecord, SampleStore, as_design, design_key, utc_timestamp
+
+if TYPE_CHECKING:  # runs/ needs only the problem's evaluate; the protocol lives above it, in optimize/
+    from mechopt.optimize.problem import DesignProblem
 
 __all__ = ["SamplingResult", "evaluate_one", "sample_designs"]
 
