@@ -20,6 +20,7 @@ import time
 import numpy as np
 
 from mechopt.errors import InputError
+from mechopt.sim.exudyn_sampling import sampled, solver_settings
 from mechopt.sim.flexible.kinematics import rigid_motion
 from mechopt.sim.flexible.parameters import FlexibleSliderCrank
 from mechopt.sim.flexible.response import Response
@@ -84,7 +85,7 @@ def simulate_exudyn(p: FlexibleSliderCrank, steps_per_sample: int = 8, newton_to
     n_slider = _add_slider(mbs, items, p, nodes[-1], u_end, m_ground_coord)
     sensors = _add_sensors(mbs, items, exu.OutputVariableType, n_slider, nodes)
     mbs.Assemble()
-    mbs.SolveDynamic(_solver_settings(exu, p, steps_per_sample, newton_tolerance))
+    mbs.SolveDynamic(solver_settings(exu, p.t_end, p.n_samples, steps_per_sample, newton_tolerance))
     return _response(mbs, p, sensors, s_nodes, start)
 
 
@@ -158,45 +159,15 @@ def _add_sensors(mbs, items, out, n_slider: int, nodes: list[int]) -> tuple[int,
     return sens_v, sens_a, sens_pos
 
 
-def _solver_settings(exu, p: FlexibleSliderCrank, steps_per_sample: int, newton_tolerance: float):
-    """Generalized-α over [0, t_end], sensors written once per sample, no file and no console output."""
-    settings = exu.SimulationSettings()
-    settings.timeIntegration.endTime = p.t_end
-    settings.timeIntegration.numberOfSteps = steps_per_sample * (p.n_samples - 1)
-    settings.timeIntegration.newton.relativeTolerance = newton_tolerance
-    settings.timeIntegration.verboseMode = 0
-    settings.solution.file.write = False
-    settings.solution.sensors.writePeriod = p.t_end / (p.n_samples - 1)
-    settings.solution.file.writeInitialValues = True
-    settings.show.computationTime = False
-    settings.show.statistics = False
-    return settings
-
-
-def _sampled(mbs, sensor: int, p: FlexibleSliderCrank) -> np.ndarray:
-    """A sensor's stored values on the ``n_samples`` sample instants, shape (n_samples, n_values)."""
-    dt_out = p.t_end / (p.n_samples - 1)
-    data = np.asarray(mbs.GetSensorStoredData(sensor))
-    # one row per write period; match rows to the sample instants by time (the first row is t = 0)
-    idx = np.rint(data[:, 0] / dt_out).astype(int)
-    keep = np.zeros(p.n_samples, dtype=bool)
-    values = np.full((p.n_samples, data.shape[1] - 1), np.nan)
-    ok = (idx >= 0) & (idx < p.n_samples) & (np.abs(data[:, 0] - idx * dt_out) < 1e-3 * dt_out)
-    values[idx[ok]] = data[ok, 1:]
-    keep[idx[ok]] = True
-    if not keep.all():
-        raise RuntimeError(f"Exudyn stored {int(keep.sum())} of {p.n_samples} samples")
-    return values
-
-
 def _response(mbs, p: FlexibleSliderCrank, sensors: tuple[int, int, list[int]], s_nodes: np.ndarray,
               start: float) -> Response:
     """V, A of the slider and the rod's deflection from its end-node chord, from the solved system's sensors."""
     sens_v, sens_a, sens_pos = sensors
     t = np.linspace(0.0, p.t_end, p.n_samples)
-    V = _sampled(mbs, sens_v, p)[:, 0]
-    A = _sampled(mbs, sens_a, p)[:, 0]
-    P = np.stack([_sampled(mbs, k, p)[:, :2] for k in sens_pos], axis=1)  # (n_samples, n + 1, 2)
+    V = sampled(mbs, sens_v, p.t_end, p.n_samples, error=RuntimeError)[:, 0]
+    A = sampled(mbs, sens_a, p.t_end, p.n_samples, error=RuntimeError)[:, 0]
+    P = np.stack([sampled(mbs, k, p.t_end, p.n_samples, error=RuntimeError)[:, :2] for k in sens_pos],
+                 axis=1)  # (n_samples, n + 1, 2)
     chord = P[:, -1] - P[:, 0]
     length = np.linalg.norm(chord, axis=1)
     normal = np.stack([-chord[:, 1], chord[:, 0]], axis=1) / length[:, None]

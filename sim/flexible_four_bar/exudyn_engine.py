@@ -25,6 +25,7 @@ import time
 import numpy as np
 
 from mechopt.errors import InputError, MechoptError
+from mechopt.sim.exudyn_sampling import sampled, solver_settings
 from mechopt.sim.flexible_four_bar.kinematics import require_crank_rocker, rigid_motion
 from mechopt.sim.flexible_four_bar.parameters import FlexibleFourBar, FlexibleLink
 from mechopt.sim.flexible_four_bar.response import FourBarResponse
@@ -90,9 +91,9 @@ def simulate_exudyn(p: FlexibleFourBar, steps_per_sample: int = 8, newton_tolera
                                                outputVariableType=out.Position)) for k in nodes]
                for nodes in (coupler, follower)]
     mbs.Assemble()
-    mbs.SolveDynamic(_solver_settings(exu, p, steps_per_sample, newton_tolerance))
-    P3 = np.stack([_sampled(mbs, k, p)[:, :2] for k in sensors[0]], axis=1)  # (n_samples, n + 1, 2)
-    P4 = np.stack([_sampled(mbs, k, p)[:, :2] for k in sensors[1]], axis=1)
+    mbs.SolveDynamic(solver_settings(exu, p.t_end, p.n_samples, steps_per_sample, newton_tolerance))
+    P3 = np.stack([sampled(mbs, k, p.t_end, p.n_samples)[:, :2] for k in sensors[0]], axis=1)  # (n_samples, n + 1, 2)
+    P4 = np.stack([sampled(mbs, k, p.t_end, p.n_samples)[:, :2] for k in sensors[1]], axis=1)
     _check_closure(p, P3, P4)
     return _response(p, P3, P4, start)
 
@@ -136,35 +137,6 @@ def _add_link(mbs, items, link: FlexibleLink, length: float, n: int, beta: float
             length=length / n, massPerLength=link.mass_per_length, bendingStiffness=ei, axialStiffness=ea,
             bendingDamping=beta * ei, axialDamping=beta * ea, nodeNumbers=[nodes[k], nodes[k + 1]]))
     return nodes
-
-
-def _solver_settings(exu, p: FlexibleFourBar, steps_per_sample: int, newton_tolerance: float):
-    """Generalized-α over [0, t_end], sensors stored once per sample, no file and no console output."""
-    settings = exu.SimulationSettings()
-    settings.timeIntegration.endTime = p.t_end
-    settings.timeIntegration.numberOfSteps = steps_per_sample * (p.n_samples - 1)
-    settings.timeIntegration.newton.relativeTolerance = newton_tolerance
-    settings.timeIntegration.verboseMode = 0
-    settings.solution.file.write = False
-    settings.solution.sensors.writePeriod = p.t_end / (p.n_samples - 1)
-    settings.solution.file.writeInitialValues = True
-    settings.show.computationTime = False
-    settings.show.statistics = False
-    return settings
-
-
-def _sampled(mbs, sensor: int, p: FlexibleFourBar) -> np.ndarray:
-    """A sensor's stored values on the ``n_samples`` sample instants, shape (n_samples, n_values)."""
-    dt_out = p.t_end / (p.n_samples - 1)
-    data = np.asarray(mbs.GetSensorStoredData(sensor))
-    # one row per write period; match rows to the sample instants by time (the first row is t = 0)
-    idx = np.rint(data[:, 0] / dt_out).astype(int)
-    ok = (idx >= 0) & (idx < p.n_samples) & (np.abs(data[:, 0] - idx * dt_out) < 1e-3 * dt_out)
-    values = np.full((p.n_samples, data.shape[1] - 1), np.nan)
-    values[idx[ok]] = data[ok, 1:]
-    if np.isnan(values).any():
-        raise MechoptError(f"Exudyn stored {len(np.unique(idx[ok]))} of {p.n_samples} samples")
-    return values
 
 
 def _check_closure(p: FlexibleFourBar, P3: np.ndarray, P4: np.ndarray) -> None:
