@@ -79,7 +79,8 @@ def check_method(method: Any, dim: int, name: str = "the problem", budget: int |
     if method not in available_methods():
         raise InputError(f"method = {method!r}; expected one of {', '.join(available_methods())} or a callable")
     if method in SPARSE_METHODS and not 2 <= dim <= 4:
-        raise InputError(f"method {method!r} handles 2 to 4 design variables; {name!r} has {dim}")
+        raise InputError(f"method {method!r} handles 2 to 4 design variables; {name!r} has {dim}: choose 'auto' "
+                         "or a baseline (`--method`, `mechopt methods`)")
     if method == AUTO_METHOD and budget is not None and budget < 2 * dim + 2:
         raise InputError(f"budget = {budget}: method {method!r} needs at least 2d + 2 = {2 * dim + 2} simulations "
                          f"for the {dim} variables of {name!r}")
