@@ -27,6 +27,7 @@ import numpy as np
 from scipy.optimize import OptimizeResult
 
 from mechopt.errors import InputError, MechoptError
+from mechopt.optimize.arguments import DEFAULT_METHOD, SPARSE_METHODS
 from mechopt.optimize.baselines import BASELINES, LIBRARY_BASELINES
 from mechopt.optimize.budget import BudgetExhausted, CountedProblem
 from mechopt.optimize.ground_truth import GroundTruth
@@ -56,6 +57,11 @@ SPENDS_WHOLE_BUDGET = frozenset(LIBRARY_BASELINES)
 #: The mark of an unfinished run in the tables.
 UNFINISHED_MARK = "†"
 
+
+
+#: mechopt's methods by the names compare gives them; ``"mechopt"`` is the study's own (its key ``method``, else
+#: the default of :func:`mechopt.minimize`).
+OUR_METHODS = {"mechopt-auto": "auto", "mechopt-sparse": "sparse", "mechopt-global": "sparse-global"}
 
 def true_objective(problem: DesignProblem, design: np.ndarray | None) -> float:
     """The objective of a returned design as the score sees it: NaN unless feasible."""
@@ -252,7 +258,7 @@ def check_methods(methods: list[str] | None, budgets: Iterable[int], gp_max_budg
     InputError
         One line, before any run or ground truth (:func:`check_limits`).
     """
-    names = ["mechopt", "mechopt-global", *BASELINES]
+    names = ["mechopt", *OUR_METHODS, *BASELINES]
     if methods:
         unknown = sorted(set(methods) - set(names))
         if unknown:
@@ -262,7 +268,8 @@ def check_methods(methods: list[str] | None, budgets: Iterable[int], gp_max_budg
     return names
 
 
-def run_one(problem: DesignProblem, truth: GroundTruth, name: str, budget: int, seed: int) -> Run:
+def run_one(problem: DesignProblem, truth: GroundTruth, name: str, budget: int, seed: int,
+            default: str = DEFAULT_METHOD) -> Run:
     """One method at one budget and seed through :func:`minimize`, scored; an unfinished run says why.
 
     Parameters
@@ -271,7 +278,7 @@ def run_one(problem: DesignProblem, truth: GroundTruth, name: str, budget: int, 
     truth : GroundTruth
         The optimum the gap is measured to.
     name : str
-        ``"mechopt"``, ``"mechopt-global"`` or a name of :data:`BASELINES`.
+        ``"mechopt"`` (the study's own method, ``default``), a name of :data:`OUR_METHODS` or of :data:`BASELINES`.
     budget : int
         Simulations the method is given.
     seed : int
@@ -289,7 +296,7 @@ def run_one(problem: DesignProblem, truth: GroundTruth, name: str, budget: int, 
         if name in BASELINES:
             method: Any = _guarded(name, BASELINES[name], outcome)
         else:
-            method = {"mechopt": "sparse", "mechopt-global": "sparse-global"}[name]
+            method = default if name == "mechopt" else OUR_METHODS[name]
         res = minimize(problem, budget=budget, method=method, seed=seed)
         x = np.asarray(res.x) if res.success else None
         nfev, message = int(res.nfev), " ".join(str(res.message).split())
@@ -321,6 +328,10 @@ def compare(study: Study, truth: GroundTruth, budgets: list[int], seeds: int, me
     """
     problem = study.problem
     names = check_methods(methods, budgets, gp_max_budget, [problem.dim])
+    own = study.method or DEFAULT_METHOD
+    if not methods:  # every method: ours once each, and the line models only where they apply (2 to 4 variables)
+        names = [n for n in names if OUR_METHODS.get(n) != own
+                 and not (OUR_METHODS.get(n) in SPARSE_METHODS and not 2 <= problem.dim <= 4)]
     caps = method_caps(gp_max_budget, problem.dim)
     for name in names:
         skipped = [b for b in budgets if b > caps.get(name, b)]
@@ -333,7 +344,7 @@ def compare(study: Study, truth: GroundTruth, budgets: list[int], seeds: int, me
             for name in names:
                 if budget > caps.get(name, budget):
                     continue
-                run = run_one(problem, truth, name, budget, seed)
+                run = run_one(problem, truth, name, budget, seed, study.method or DEFAULT_METHOD)
                 runs.append(run)
                 own_stop = run.finished and run.nfev < run.budget and run.message
                 progress(f"  {run.describe()}, {run.wall_time_s:.1f} s" + (f" ({run.message})" if own_stop else ""))

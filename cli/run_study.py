@@ -23,7 +23,7 @@ from mechopt.cli.study_plan import RunPlan, duration_text, open_store_if_any, pl
 from mechopt.errors import InputError
 from mechopt.optimize.arguments import check_method
 from mechopt.optimize.ground_truth import GroundTruth, load_or_compute
-from mechopt.optimize.minimize import run_method
+from mechopt.optimize.minimize import parallel_accounting, run_method
 from mechopt.optimize.result import OptimizeResult
 from mechopt.optimize.sparse.options import SparseOptions
 from mechopt.optimize.sparse.sampler import Sampler
@@ -34,7 +34,8 @@ from mechopt.runs.executors import default_workers, make_executor
 from mechopt.runs.store import SampleStore
 from mechopt.studies.catalogue import Study
 
-__all__ = ["StudyRun", "check_output_folder", "plan_study", "run_study", "study_options", "summary_lines"]
+__all__ = ["StudyRun", "check_output_folder", "plan_study", "rounds_text", "run_study", "study_options",
+           "summary_lines"]
 
 
 @dataclass
@@ -130,7 +131,9 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
         result = run_method(problem, method, options, sampler, log)
         timings["optimise_s"] = time.perf_counter() - t0
         n_opt = len(sampler.designs)
-        log(f"  {_optimised_line(result)}")
+        timing = sampler.timing()
+        result.update(parallel_accounting(sampler))
+        log(f"  {_optimised_line(result)}; {rounds_text(timing)}")
         validation = _validate(result, problem, options, sampler, timings, log)
         n_val = len(sampler.designs) - n_opt
         if result.model is not None:
@@ -138,8 +141,10 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
         t0 = time.perf_counter()
         references = _references(study, result.x, sampler)
         timings["references_s"] = time.perf_counter() - t0
+        # The rounds, waiting and computing of the whole run (validation and references included) and, apart, of
+        # the optimisation alone (issue 28).
         sampling = {**sampler.summary(), "optimisation": n_opt, "validation": n_val,
-                    "references": len(sampler.designs) - n_opt - n_val}
+                    "references": len(sampler.designs) - n_opt - n_val, "optimisation_timing": timing}
         failures = [(np.array(d), e) for d, e in sampler.failures.values()]
     ground = _ground_truth(problem, out, truth, truth_step, timings)
     if result.method == "sparse":
@@ -258,4 +263,13 @@ def _simulations_line(run: StudyRun) -> str:
     return (f"simulations: {s['optimisation']} to optimise (budget {budget}, method {run.result.method}{on_lines}), "
             f"{val}, {s['references']} more for the reference designs; {in_all} designs in all: {s['new']} new, "
             f"{s['reused']} reused from the store, {s['failed']} failed, {s['waited_for_other_runs']} computed by "
-            f"another run; {s['executor']}; {wall}; outputs in {run.out}")
+            f"another run; {s['executor']}; {rounds_text(s)}; {wall}; outputs in {run.out}")
+
+
+def rounds_text(s: dict[str, Any]) -> str:
+    """The parallel accounting of a run (issue 28): rounds, the workers' idle share, waiting and computing."""
+    if "rounds" not in s:
+        return "rounds not counted"
+    return (f"{s['rounds']} round{'' if s['rounds'] == 1 else 's'} of simulations on {s['workers']} "
+            f"worker{'' if s['workers'] == 1 else 's'} (idle {s['idle_share']:.0%} of their time), "
+            f"{s['waiting_s']:.1f} s waiting for simulations, {s['method_s']:.1f} s of the method's own computing")

@@ -49,9 +49,9 @@ def add_method_option(p: argparse.ArgumentParser) -> None:
     """``--method``: any name :func:`mechopt.minimize` accepts."""
     # The names are checked after parsing (mechopt.optimize.arguments.check_method): listing them here would import
     # every baseline library at each call of the command line.
-    p.add_argument("--method", default="sparse", metavar="NAME",
-                   help="the optimizer: sparse (default; the line model of paper 002), sparse-global, or a baseline "
-                   "(`mechopt methods` lists them)")
+    p.add_argument("--method", default=None, metavar="NAME",
+                   help="the optimizer: the study's own (its key `method`), else mechopt's default; sparse (the line "
+                   "model of paper 002), sparse-global, auto, or a baseline (`mechopt methods` lists them)")
 
 
 def overrides(args: argparse.Namespace) -> dict[str, Any]:

@@ -33,9 +33,10 @@ def add_parser(sub, engines: tuple[str, ...]) -> None:
 def run(args: argparse.Namespace, rest: list[str]) -> int:
     """Run the study named on the command line and print its summary."""
     from mechopt.cli.run_study import check_output_folder, plan_study, run_study, study_options, summary_lines
-    from mechopt.optimize.arguments import check_budget, check_method
+    from mechopt.optimize.arguments import DEFAULT_METHOD, check_budget, check_method
 
     study = load(args, args.name)
+    args.method = args.method or study.method or DEFAULT_METHOD
     if args.budget is not None:
         check_budget(args.budget)
     check_method(args.method, study.problem.dim, study.name)

@@ -22,7 +22,11 @@ from mechopt.optimize.sparse.stage import planned_designs
 from mechopt.runs.store import SampleStore, design_key
 from mechopt.studies.catalogue import Study
 
-__all__ = ["PlanStage", "RunPlan", "duration_text", "open_store_if_any", "plan_run", "seconds_per_run"]
+__all__ = ["BATCH_METHODS", "PlanStage", "RunPlan", "duration_text", "open_store_if_any", "plan_run",
+           "seconds_per_run"]
+
+#: The methods that propose as many designs at once as there are workers (issue 28).
+BATCH_METHODS = ("sparse", "sparse-global", "auto")
 
 
 @dataclass(frozen=True)
@@ -38,9 +42,13 @@ class PlanStage:
     held : int
         Of those, how many the store already holds (not simulated again).
     parallel : bool
-        Whether its designs run ``workers`` at a time (lines, held-out lines) or one after the other (refinement).
+        Whether its designs run ``workers`` at a time (lines, held-out lines, and since issue 28 every step of the
+        sparse methods, proposed in batches of ``workers``) or one after the other (the baselines).
     exact : bool
         Whether ``simulations`` is the count (True) or an upper bound (the refinement may stop earlier).
+    width : int, optional
+        Most designs a round of this stage holds whatever the workers (the local search: a design and its
+        gradient's d, d + 1); None: the workers.
     """
 
     name: str
@@ -48,16 +56,22 @@ class PlanStage:
     held: int = 0
     parallel: bool = True
     exact: bool = True
+    width: int | None = None
 
     @property
     def new(self) -> int:
         """Designs this stage will simulate."""
         return max(0, self.simulations - self.held)
 
+    def rounds(self, workers: int) -> int:
+        """Rounds of simulations run at the same time: ``new / workers`` rounded up, or ``new`` one after the
+        other."""
+        at_once = max(1, workers if self.width is None else min(workers, self.width))
+        return math.ceil(self.new / at_once) if self.parallel else self.new
+
     def seconds(self, per_run: float, workers: int) -> float:
-        """Expected wall time (s) at ``per_run`` seconds a simulation on ``workers`` workers."""
-        rounds = math.ceil(self.new / max(1, workers)) if self.parallel else self.new
-        return rounds * per_run
+        """Expected wall time (s) at ``per_run`` seconds a simulation on ``workers`` workers: rounds × per_run."""
+        return self.rounds(workers) * per_run
 
 
 @dataclass(frozen=True)
@@ -98,8 +112,13 @@ class RunPlan:
         return sum(s.new for s in self.stages)
 
     @property
+    def rounds(self) -> int:
+        """Rounds of at most ``workers`` simulations at once that the run expects (one simulation's time each)."""
+        return sum(s.rounds(self.workers) for s in self.stages)
+
+    @property
     def seconds(self) -> float | None:
-        """Expected wall time of the simulations (s; None when the cost of one is unknown)."""
+        """Expected wall time of the simulations (s; None when the cost of one is unknown): rounds × per_run."""
         if self.per_run is None:
             return None
         return sum(s.seconds(self.per_run, self.workers) for s in self.stages)
@@ -113,9 +132,14 @@ class RunPlan:
             count = f"{s.simulations}" if s.exact else f"up to {s.simulations}"
             held = f", {s.held} already in the store" if s.held else ""
             when = "" if self.per_run is None else f", about {duration_text(s.seconds(self.per_run, self.workers))}"
-            order = "" if s.parallel else " (one at a time)"
+            width = self.workers if s.width is None else min(self.workers, s.width)
+            order = (" (one at a time)" if not s.parallel else
+                     f" ({s.rounds(self.workers)} round{'' if s.rounds(self.workers) == 1 else 's'} of "
+                     f"{width})" if self.workers > 1 else "")
             lines.append(f"  {s.name}: {count} simulation{'' if s.simulations == 1 else 's'}{held}{order}{when}")
-        cost = "unknown" if self.seconds is None else f"about {duration_text(self.seconds)}"
+        cost = "unknown" if self.seconds is None else (
+            f"about {duration_text(self.seconds)} on {self.workers} worker{'' if self.workers == 1 else 's'} "
+            f"({self.rounds} rounds × {self.per_run:.3g} s)")
         lines.append(f"  in all: at most {self.total} designs, {self.new} to simulate; expected simulation time {cost} "
                      f"({self.cost_source})")
         return lines
@@ -124,9 +148,9 @@ class RunPlan:
         """JSON-able plan (``result.json`` → ``plan``)."""
         return {"budget": self.budget, "validation": self.validation, "workers": self.workers,
                 "seconds_per_run": self.per_run, "cost_source": self.cost_source, "total": self.total,
-                "new": self.new, "expected_s": self.seconds,
+                "new": self.new, "expected_s": self.seconds, "rounds": self.rounds,
                 "stages": [{"name": s.name, "simulations": s.simulations, "held": s.held, "parallel": s.parallel,
-                            "exact": s.exact} for s in self.stages]}
+                            "exact": s.exact, "rounds": s.rounds(self.workers)} for s in self.stages]}
 
 
 def duration_text(seconds: float) -> str:
@@ -200,11 +224,11 @@ def plan_run(study: Study, options: SparseOptions, method: str, store: SampleSto
                                 _held(store, on_lines, fingerprint, retry_failed)))
         stages.append(PlanStage("confirm the model's candidate", 1))
         if options.refine and budget - n_lines - 1 > 0:
-            stages.append(PlanStage("refine on the simulator (model steps, SLSQP, corrected steps)",
-                                    budget - n_lines - 1, parallel=False, exact=False))
+            stages.extend(_refinement(budget - n_lines - 1, workers, problem.dim))
         n_val_lines, per_line = options.validation_plan()
     else:
-        stages.append(PlanStage(f"method {method}", budget, parallel=False, exact=False))
+        # sparse-global and auto propose batches of ``workers`` designs (issue 28); the baselines one at a time.
+        stages.append(PlanStage(f"method {method}", budget, parallel=method in BATCH_METHODS, exact=False))
         n_val_lines, per_line = 0, 0
     validation = n_val_lines * per_line
     if validation:
@@ -215,6 +239,22 @@ def plan_run(study: Study, options: SparseOptions, method: str, store: SampleSto
                                 _held(store, np.vstack(list(references.values())), fingerprint, retry_failed)))
     per_run, source = seconds_per_run(study, store)
     return RunPlan(stages, budget, validation, workers, per_run, source)
+
+
+def _refinement(left: int, workers: int, dim: int) -> list[PlanStage]:
+    """The sparse method's refinement: one stage one at a time; with batches, the model steps in rounds of
+    ``workers`` (their share of what is left, :data:`~mechopt.optimize.sparse.pipeline.BATCH_MODEL_STEP_SHARE`)
+    and the local search's designs with their gradients, d + 1 a round (issue 28)."""
+    from mechopt.optimize.sparse.pipeline import BATCH_MODEL_STEP_SHARE
+
+    if workers <= 1:
+        return [PlanStage("refine on the simulator (model steps, SLSQP, corrected steps)", left, exact=False)]
+    steps = min(left, max(workers, int(BATCH_MODEL_STEP_SHARE * left)))
+    stages = [PlanStage("refine: model steps", steps, exact=False)]
+    if left > steps:
+        stages.append(PlanStage("refine: local search (each design with its gradient) and corrected steps",
+                                left - steps, exact=False, width=dim + 1))
+    return stages
 
 
 def open_store_if_any(path: Path) -> SampleStore | None:

@@ -21,6 +21,8 @@ SPARSE_METHODS = ("sparse", "sparse-global")
 
 #: The default method of :func:`mechopt.minimize` (:mod:`mechopt.optimize.auto`): its plan follows d and the budget.
 AUTO_METHOD = "auto"
+#: The method of :func:`mechopt.minimize` and of a study that names none.
+DEFAULT_METHOD = AUTO_METHOD
 
 
 def _baselines() -> dict[str, Callable[..., Any]]:

@@ -11,9 +11,10 @@ from typing import Any
 
 import numpy as np
 
-from mechopt.errors import InfeasibleDesignError, InputError
+from mechopt.errors import InfeasibleDesignError, InputError, MechoptError
 from mechopt.optimize.arguments import (
     AUTO_METHOD,
+    DEFAULT_METHOD,
     SPARSE_METHODS,
     check_budget,
     check_method,
@@ -31,7 +32,7 @@ from mechopt.optimize.sparse.validate import validate
 from mechopt.runs.executors import make_executor
 from mechopt.runs.store import SampleStore
 
-__all__ = ["METHODS", "minimize", "run_method"]
+__all__ = ["METHODS", "minimize", "parallel_accounting", "run_method"]
 
 #: ``"sparse"``: the pipeline of paper 002 (global model, confirmation, local refinement) — for smooth landscapes;
 #: ``"sparse-global"``: the same lines and blend made global on multimodal ones (basins of the blend and of its
@@ -57,8 +58,8 @@ def _check_arguments(problem: Any, budget: Any, method: Any, seed: Any, workers:
     check_workers(workers)
 
 
-def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[..., Any] = "sparse", seed: int = 0,
-             workers: int | None = 1, store: str | Path | SampleStore | None = None,
+def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[..., Any] = DEFAULT_METHOD,
+             seed: int = 0, workers: int | None = 1, store: str | Path | SampleStore | None = None,
              options: Mapping[str, Any] | SparseOptions | None = None, scheduler: Any = None,
              progress: bool = False, retry_failed: bool = False,
              log: Callable[[str], None] | None = None) -> OptimizeResult:
@@ -71,10 +72,11 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
     budget : int
         Most simulations the method may ask for (validation simulations of the sparse method come on top).
     method : str or callable
-        ``"sparse"`` (default: the line-sampled sparse model of paper 002, then a local search on the simulator;
-        2 to 4 variables), ``"auto"`` (Gaussian-process steps on a plan chosen by dimension and budget, 2 to 12
-        variables, failed simulations learned and avoided; needs a budget >= 2d + 2; :mod:`mechopt.optimize.auto`;
-        the default-to-be, once it meets its benchmarks: see the README),
+        ``"auto"`` (default: a plan chosen by dimension, budget and the problem's declaration, 2 to 12 variables,
+        budgets from 2d + 2: Gaussian-process steps, in a trust region above 4 variables, or Gauss-Newton runs on the
+        residuals of a least-squares problem; failed simulations learned and avoided; :mod:`mechopt.optimize.auto`),
+        ``"sparse"`` (the line-sampled sparse model of paper 002, then a local search on the simulator; 2 to 4
+        variables),
         ``"sparse-global"`` (for multimodal objectives: the lines' blend, its basins, then steps on the blend
         corrected by every simulation; :mod:`mechopt.optimize.sparse_global`), a
         baseline's name (``"slsqp"``, ``"differential_evolution"``...) or a callable
@@ -82,7 +84,9 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
     seed : int
         Seed of every random choice.
     workers : int, optional
-        Local processes evaluating designs; 1 (default) runs in this process.  None uses every core.
+        Local processes evaluating designs; 1 (default) runs in this process.  None uses every core.  The methods
+        ``"sparse"`` and ``"sparse-global"`` propose as many designs at once as there are workers (Dask: the
+        cluster's worker threads); with one worker they behave exactly as one at a time.
     store : path or SampleStore, optional
         SQLite sample store: designs found there (same problem fingerprint) are not simulated again, and every new
         one is committed as soon as it is known.  Default: a temporary store, discarded at the end.
@@ -90,7 +94,9 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
         Options of the sparse method (``SparseOptions.help()``); defaults are scaled to the budget.
         ``validation_lines`` defaults to 0 here (no held-out lines).
     scheduler : str, optional
-        A Dask scheduler address to evaluate on instead of local processes.
+        A Dask scheduler address (or a client, or a ``LocalCluster``) to evaluate on instead of local processes;
+        ``workers`` is then how many designs run at once there: ``workers=None`` for every worker thread of the
+        cluster (the default 1 runs one at a time).
     progress : bool
         Progress bars with rate and ETA.
     retry_failed : bool
@@ -101,8 +107,9 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
     Returns
     -------
     OptimizeResult
-        ``x``, ``fun``, ``outputs``, ``nfev``, ``success``, ``message`` and, for the sparse method, ``model``,
-        ``stages`` and ``validation``.
+        ``x``, ``fun``, ``outputs``, ``nfev``, ``success``, ``message``, the accounting of the parallel run
+        (``rounds``, ``batch_size``, ``idle_share``, ``waiting_s``, ``method_s``) and, for the sparse method,
+        ``model``, ``stages`` and ``validation``.
 
     Raises
     ------
@@ -122,14 +129,22 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
             result["validation"] = validate(result.model, ModelSpace(problem), sampler, opts.validation_lines,
                                             opts.validation_points, opts.seed, f_min=result.fun)
             result["trust"] = study_trust(result.stages[0], result.pipeline.best, result.validation)
-        result["sampling"] = sampler.summary()
         result["nnew"], result["nreused"] = sampler.n_computed, sampler.n_cached
         result["nfailed"] = len(sampler.failures)
         if result.success:
             record = sampler.records(np.asarray(result.x)[None, :], desc="optimum")[0]
             result["outputs"] = dict(record.outputs)
+        result["sampling"] = sampler.summary()
+        result.update(parallel_accounting(sampler))
     result["wall_time_s"] = time.perf_counter() - t0
     return result
+
+
+def parallel_accounting(sampler: Sampler) -> dict[str, Any]:
+    """``rounds``, ``batch_size``, ``idle_share``, ``waiting_s`` and ``method_s`` of a run so far (issue 28)."""
+    timing = sampler.timing()
+    return {"rounds": timing["rounds"], "batch_size": sampler.batch_size, "idle_share": timing["idle_share"],
+            "waiting_s": timing["waiting_s"], "method_s": timing["method_s"]}
 
 
 def _options(problem: DesignProblem, options: Mapping[str, Any] | SparseOptions | None, budget: int,
@@ -188,7 +203,12 @@ def run_method(problem: DesignProblem, method: str | Callable[..., Any], opts: S
 
 def _sparse(problem: DesignProblem, opts: SparseOptions, sampler: Sampler, log: Callable[[str], None]):
     space = ModelSpace(problem)
-    pipeline = run_pipeline(space, opts, sampler, log=log)
+    try:
+        pipeline = run_pipeline(space, opts, sampler, log=log)
+    except MechoptError as exc:
+        if isinstance(exc, InputError) or not sampler.failures:
+            raise
+        return _handed_to_auto(problem, opts, sampler, f"the line model could not be built ({exc})", log)
     success = bool(np.isfinite(pipeline.fun) and space.feasible(pipeline.x)[0])
     return OptimizeResult(x=pipeline.x, fun=pipeline.fun, nfev=len(sampler.designs), success=success,
                           message=pipeline.message, method="sparse", model=pipeline.stages[0].model,
@@ -205,26 +225,59 @@ def _sparse_global(problem: DesignProblem, budget: int, seed: int, sampler: Samp
     def margins(X: np.ndarray) -> np.ndarray:
         return problem.constraint_margins(np.atleast_2d(X))
 
-    res = global_search(evaluate, problem.bounds, problem.feasible, problem.sampleable, budget=budget,
-                        fit=problem.fit, seed=seed, margins=margins if problem.constraints else None)
-    success = bool(np.all(np.isfinite(res.x)) and problem.feasible(res.x)[0])
+    # A least-squares problem keeps a fifth of the budget for Gauss-Newton from the global phase's best design.
+    local = max(5 * (problem.dim + 1), budget // 5) if problem.residuals and budget >= 60 else 0
+    res = global_search(evaluate, problem.bounds, problem.feasible, problem.sampleable, budget=budget - local,
+                        fit=problem.fit, seed=seed, margins=margins if problem.constraints else None,
+                        batch=sampler.batch_size)
+    x, fun = np.asarray(res.x, dtype=float), float(res.fun)
     trust = dict(res.trust)
-    return OptimizeResult(x=np.asarray(res.x, dtype=float), fun=float(res.fun), nfev=len(sampler.designs),
-                          success=success, message=str(trust.get("verdict", "")), method="sparse-global",
-                          model=None, models=res.models, stages=[], validation=None, trust=trust)
+    message = str(trust.get("verdict", ""))
+    if local and np.all(np.isfinite(x)):
+        from mechopt.optimize.least_squares import least_squares_polish
+
+        x_ls, run = least_squares_polish(lambda X: sampler.residuals(X, desc="sparse-global: Gauss-Newton"),
+                                         problem.bounds, x, budget - len(sampler.designs), problem.fd_step,
+                                         batch=sampler.batch_size, feasible=problem.feasible,
+                                         margins=margins if problem.constraints else None)
+        if np.isfinite(run.value) and run.value < fun:
+            x, fun = np.asarray(x_ls, dtype=float), float(run.value)
+        message += f"; Gauss-Newton on the residuals from its best design: {fun:.6g} ({run.message})"
+    success = bool(np.all(np.isfinite(x)) and problem.feasible(x)[0])
+    return OptimizeResult(x=x, fun=fun, nfev=len(sampler.designs), success=success, message=message,
+                          method="sparse-global", model=None, models=res.models, stages=[], validation=None,
+                          trust=trust)
 
 
-def _auto(problem: DesignProblem, budget: int, seed: int, sampler: Sampler) -> OptimizeResult:
+def _handed_to_auto(problem: DesignProblem, opts: SparseOptions, sampler: Sampler, why: str,
+                    log: Callable[[str], None]) -> OptimizeResult:
+    """The rest of the budget to the default method, which learns where the simulator fails, with every design the
+    line model simulated as its start (failed simulations must not end a run: issue 22)."""
+    left = int(opts.budget) - len(sampler.designs)
+    log(f"  {why}: the remaining {left} simulations go to method 'auto'")
+    initial = np.array([d for d, _ in sampler.history.values()]) if sampler.history else None
+    result = _auto(problem, max(left, 0), int(opts.seed), sampler, initial=initial)
+    result["message"] = f"{why}; {result.message}"
+    result["method"] = "sparse"
+    return result
+
+
+def _auto(problem: DesignProblem, budget: int, seed: int, sampler: Sampler,
+          initial: np.ndarray | None = None) -> OptimizeResult:
     from mechopt.optimize.auto import auto_search
 
     def evaluate(X: np.ndarray) -> np.ndarray:
         return sampler(np.atleast_2d(X), desc=AUTO_METHOD)
 
+    def residuals(X: np.ndarray) -> tuple[np.ndarray, list]:
+        return sampler.residuals(np.atleast_2d(X), desc=AUTO_METHOD)
+
     def margins(X: np.ndarray) -> np.ndarray:
         return problem.constraint_margins(np.atleast_2d(X))
 
     res = auto_search(evaluate, problem.bounds, budget, seed, feasible=problem.feasible,
-                      margins=margins if problem.constraints else None)
+                      batch=sampler.batch_size, margins=margins if problem.constraints else None,
+                      residuals=residuals if problem.residuals else None, fd_step=problem.fd_step, initial=initial)
     success = bool(np.all(np.isfinite(res.x)) and problem.feasible(res.x)[0])
     return OptimizeResult(x=res.x, fun=res.fun, nfev=len(sampler.designs), success=success, message=res.message,
                           method=AUTO_METHOD, plan=res.plan.name, model=None, stages=[], validation=None)

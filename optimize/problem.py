@@ -143,6 +143,11 @@ class DesignProblem:
         Finite-difference step of local searches on the simulator, as a fraction of each variable's range: above
         the simulator's noise (a time-stepping engine: 1e-3), as small as the arithmetic allows for a smooth,
         closed-form one (1e-5, the default).
+    residuals : str
+        A least-squares problem names here the output of :meth:`evaluate` that holds its residual vector (a list
+        of floats); its objective must be zero exactly where the residuals are (a sum of squares, or a sum of RMS
+        terms).  The methods' local phases then take Gauss-Newton steps on the residuals
+        (:mod:`mechopt.optimize.least_squares`).  Empty (default): a plain scalar objective.
     """
 
     name: ClassVar[str] | str = "problem"
@@ -155,6 +160,7 @@ class DesignProblem:
     version: int = 1
     surrogate_order: tuple[int, ...] | None = None
     fd_step: float = 1e-5
+    residuals: str = ""
 
     # --- to implement -------------------------------------------------------------------------------------------
 
@@ -297,6 +303,26 @@ class DesignProblem:
         """The objective from an evaluation's outputs."""
         return float(outputs[self.objective])
 
+    def residual_vector(self, outputs: Mapping[str, Any]) -> np.ndarray:
+        """The residual vector of an evaluation's outputs (a least-squares problem; :attr:`residuals`).
+
+        Raises
+        ------
+        InputError
+            The problem declares no residuals, or the output is missing or not a flat list of finite numbers.
+        """
+        if not self.residuals:
+            raise InputError(f"problem {self.name!r} declares no residuals (set its `residuals` attribute)")
+        try:
+            r = np.asarray(outputs[self.residuals], dtype=float)
+        except KeyError:
+            raise InputError(f"problem {self.name!r}: evaluate() returned no {self.residuals!r} "
+                             f"(its declared residuals)") from None
+        if r.ndim != 1 or not r.size or not np.all(np.isfinite(r)):
+            raise InputError(f"problem {self.name!r}: output {self.residuals!r} must be a non-empty flat list of "
+                             f"finite numbers, got shape {r.shape}")
+        return r
+
     def fingerprint(self) -> str:
         """Hash of the problem's identity and :meth:`settings` (the key of its rows in the sample store)."""
         return fingerprint({
@@ -317,6 +343,8 @@ class DesignProblem:
             raise InputError(f"{where}: variable names {list(self.names)} are not distinct")
         if not self.outputs or self.objective not in self.outputs:
             raise InputError(f"{where}: objective {self.objective!r} must be one of outputs {list(self.outputs)}")
+        if not isinstance(self.residuals, str) or (self.residuals and not self.residuals.isidentifier()):
+            raise InputError(f"{where}: residuals = {self.residuals!r}; expected the name of an output or ''")
         if self.fit not in FITS:
             raise InputError(f"{where}: fit = {self.fit!r}; expected one of {', '.join(FITS)}")
         order = self.surrogate_order

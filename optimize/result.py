@@ -38,7 +38,18 @@ class OptimizeResult(_ScipyResult):
         Whether the line model resolves the landscape, and where the answer came from (``verdict``: one
         sentence; studies and ``"sparse-global"``; :func:`mechopt.optimize.sparse.trust.study_trust`).
     sampling : dict
-        Counts and the executor used.
+        Counts, the executor used and the timing of :meth:`mechopt.optimize.sparse.sampler.Sampler.timing`.
+    rounds : int
+        Rounds of simulations: calls that dispatched designs to the simulators (at most ``batch_size`` at once run
+        together; the optimum's final look-up included, free when it was simulated before).
+    batch_size : int
+        Designs the method could propose at once: the workers (local processes or the Dask cluster's threads).
+    idle_share : float
+        Share of the workers' time (``batch_size`` × the run's wall time) not spent simulating.
+    waiting_s : float
+        Seconds the method waited for simulations (inside the sampler's calls).
+    method_s : float
+        Seconds of the method's own computing: the wall time of the run minus ``waiting_s``.
     wall_time_s : float
         Wall time of the call.
     """

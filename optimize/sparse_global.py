@@ -300,7 +300,7 @@ def global_search(evaluate: BatchEvaluator, bounds: Any, feasible: Predicate, sa
                   samples_per_line: int = 5, n_lines: int | None = None, max_order: int = 4,
                   n_candidates: int | None = None, kappa: float = 1.0, basin_radius: float = 0.12,
                   exploit_share: float = 0.15, cycle: tuple[float, ...] = DISTANCE_CYCLE,
-                  steps: bool = True) -> GlobalSearchResult:
+                  steps: bool = True, batch: int = 1) -> GlobalSearchResult:
     """Global minimum of an expensive function from samples on lines, their blend, its basins and steps on the
     blend corrected by every simulation (see the module docstring).
 
@@ -350,6 +350,8 @@ def global_search(evaluate: BatchEvaluator, bounds: Any, feasible: Predicate, sa
     steps : bool
         Take the steps on the corrected blend (False: the lines and the blend's basins only, what the line model
         alone finds; the rest of the budget is not spent).
+    batch : int
+        Designs evaluated at once (issue 28): steps on the corrected blend, and more basins; 1 (default): as ever.
 
     Returns
     -------
@@ -362,13 +364,14 @@ def global_search(evaluate: BatchEvaluator, bounds: Any, feasible: Predicate, sa
     """
     b = _checked_bounds(bounds, fit, budget, global_share, exploit_share, cycle)
     if n_candidates is None:
-        n_candidates = int(np.clip(budget // 40, 1, 4))
+        # The basins are one round whatever their number: free workers simulate more of them (issue 28).
+        n_candidates = max(int(np.clip(budget // 40, 1, 4)), min(4, math.ceil(batch / 2)))
     run = _GlobalRun(evaluate, b, feasible, feasible if sampleable is None else sampleable, budget, fit)
     glob = run.global_stage(global_share, samples_per_line, n_lines, max_order, seed, kappa, n_candidates,
                             basin_radius)
     best_before_steps = run.counted.best(run.feas_z)
     if steps and run.counted.nfev and run.counted.remaining > 0:
-        run.corrected_steps(glob, exploit_share, seed, cycle, margins)
+        run.corrected_steps(glob, exploit_share, seed, cycle, margins, max(1, int(batch)))
     return run.result(best_before_steps)
 
 
@@ -474,29 +477,38 @@ class _GlobalRun:
             self.trust["claim_error"] = abs(self.cand_pred[j] - self.cand_f[j]) / sampled_range
 
     def corrected_steps(self, glob: _Fitted | None, exploit_share: float, seed: int, cycle: tuple[float, ...],
-                        margins: Callable[[np.ndarray], np.ndarray] | None) -> None:
+                        margins: Callable[[np.ndarray], np.ndarray] | None, batch: int = 1) -> None:
         """Step 3: steps on the blend corrected by every simulation, first cycling through distances from the
         simulated designs (unseen regions, then closer), then at the corrected model's own minimum."""
         counted, lower, width = self.counted, self.lower, self.width
         square = self.fit == "square"
 
+        def step_values(Z: np.ndarray) -> np.ndarray:
+            values = counted(np.atleast_2d(Z), "corrected model")
+            for z, value in zip(np.atleast_2d(Z), values, strict=True):
+                if square and value < 0:
+                    raise InputError(f"fit='square' needs a non-negative objective, got {value:.4g} at "
+                                     f"{(lower + z * width).tolist()}")
+            return values * values if square else values
+
         def step_value(z: np.ndarray) -> float:
-            value = float(counted(z[None, :], "corrected model")[0])
-            if square and value < 0:
-                raise InputError(f"fit='square' needs a non-negative objective, got {value:.4g} at "
-                                 f"{(lower + z * width).tolist()}")
-            return value * value if square else value
+            return float(step_values(z[None, :])[0])
 
         margins_z = None if margins is None else (
             lambda Z: np.asarray(margins(counted.x(Z)), dtype=float).reshape(len(np.atleast_2d(Z)), -1))
         trend = None if glob is None else glob.model.predict
         f_all = np.array(counted.f)
         n_exploit = min(counted.remaining, int(round(exploit_share * self.budget)))
+        if batch > 1:
+            # Whole rounds for the exploring steps: a last round of a few would leave the other workers idle.
+            n_explore = min(counted.remaining, math.ceil((counted.remaining - n_exploit) / batch) * batch)
+            n_exploit = counted.remaining - n_explore
         Z, q = explore(step_value, np.array(counted.Z), f_all * f_all if square else f_all, trend, self.feas_z,
-                       counted.remaining - n_exploit, seed, cycle)
+                       counted.remaining - n_exploit, seed, cycle, batch=batch, simulate_batch=step_values)
         self.stages.append({"name": "corrected model, exploring", "nfev": counted.nfev,
                             "best": counted.best(self.feas_z)[1]})
-        explore(step_value, Z, q, trend, self.feas_z, counted.remaining, seed + 1, (0.0,), margins=margins_z)
+        explore(step_value, Z, q, trend, self.feas_z, counted.remaining, seed + 1, (0.0,), margins=margins_z,
+                batch=batch, simulate_batch=step_values)
         self.stages.append({"name": "corrected model, exploiting", "nfev": counted.nfev,
                             "best": counted.best(self.feas_z)[1]})
 

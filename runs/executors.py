@@ -22,6 +22,7 @@ import os
 import pickle
 import socket
 import threading
+import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
@@ -31,6 +32,7 @@ from typing import Any, TypeVar
 from urllib.parse import urlsplit
 
 from mechopt.errors import InputError, StudyError
+from mechopt.runs.forkserver_main import MAIN_VARIABLE
 
 __all__ = [
     "DaskExecutor",
@@ -161,9 +163,38 @@ def _mp_context() -> multiprocessing.context.BaseContext:
         return multiprocessing.get_context("spawn")
     context = multiprocessing.get_context("forkserver")
     # The server imports mechopt (numpy, scipy...) once and forks every worker from it, instead of each worker
-    # importing it anew (seconds per worker).  Only the first start of the server reads this list.
-    context.set_forkserver_preload(["__main__", "mechopt.runs.sampling"])
+    # importing it anew (seconds per worker).  Only the first start of the server reads this list.  The main
+    # script goes through mechopt.runs.forkserver_main: the server's own preload of "__main__" never gets its path.
+    main = _main_for_forkserver()
+    if main:
+        os.environ.setdefault(MAIN_VARIABLE, main)
+    context.set_forkserver_preload(["__main__", "mechopt.runs.forkserver_main", "mechopt.runs.sampling"])
     return context
+
+
+def _main_for_forkserver() -> str:
+    """``path:FILE`` or ``name:MODULE`` of the main script, as the workers would import it; "" for none."""
+    from multiprocessing import spawn
+
+    data = spawn.get_preparation_data("mechopt-worker")
+    if data.get("init_main_from_name"):
+        return f"name:{data['init_main_from_name']}"
+    if data.get("init_main_from_path"):
+        return f"path:{data['init_main_from_path']}"
+    return ""
+
+
+def _pause(seconds: float) -> None:
+    """A task that only takes a worker for a moment: each warm-up task then starts a worker of its own."""
+    time.sleep(seconds)
+
+
+def _warm_up(pool: ProcessPoolExecutor, workers: int) -> None:
+    """Start every worker of ``pool`` (a pool starts one per submitted task while none is idle)."""
+    try:
+        wait([pool.submit(_pause, 0.05) for _ in range(workers)])
+    except Exception:  # noqa: BLE001 - closed or broken meanwhile: the first real task reports it
+        pass
 
 
 class ProcessExecutor(SampleExecutor):
@@ -189,6 +220,9 @@ class ProcessExecutor(SampleExecutor):
         self._pool: ProcessPoolExecutor | None = ProcessPoolExecutor(
             max_workers=workers, mp_context=_mp_context(), initializer=_die_with_parent
         )
+        # Start the workers now, in the background, while the method plans its first designs (issue 28: on a busy
+        # machine a cold start of 8 workers took seconds, before the first simulation).
+        threading.Thread(target=_warm_up, args=(self._pool, workers), name="mechopt-pool-warm-up", daemon=True).start()
 
     def map_unordered(self, fn: Callable[[T], R], items: Iterable[T]) -> Iterator[R]:
         """Run ``fn`` over ``items`` in the worker processes (see :meth:`SampleExecutor.map_unordered`).

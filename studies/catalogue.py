@@ -53,6 +53,9 @@ class Study:
         The paper's figures the report compares with (``[paper]``).
     file : StudyFile
         The parsed file, for the sections later stages read (``surrogate``, ``compare``...).
+    method : str
+        The study's own choice of method (its key ``method``; ``--method`` overrides it); empty: the default of
+        :func:`mechopt.minimize`.
     """
 
     name: str
@@ -63,6 +66,7 @@ class Study:
     designs: dict[str, dict[str, float]] = field(default_factory=dict)
     paper: dict[str, Any] = field(default_factory=dict)
     file: StudyFile | None = None
+    method: str = ""
 
     def design(self, name: str) -> np.ndarray:
         """Reference design ``name`` as an array in the problem's variable order."""
@@ -182,8 +186,11 @@ def _load_cached(path_str: str, _mtime: int, options: tuple) -> Study:
         raise StudyError(f"{path.name}: {exc}") from None
     designs = _designs(file, problem)
     paper = file.table("paper", required=False)
+    method = config.get("method", "")
+    if not isinstance(method, str):
+        raise StudyError(f"{path.name}: key method must be a method's name (`mechopt methods`), got {method!r}")
     return Study(name=name, path=path, description=str(config.get("description", "")), kind=kind, problem=problem,
-                 designs=designs, paper=dict(paper), file=file)
+                 designs=designs, paper=dict(paper), file=file, method=method)
 
 
 def _designs(file: StudyFile, problem: DesignProblem) -> dict[str, dict[str, float]]:

@@ -24,6 +24,7 @@ MECHANISMS: dict[str, str] = {
     "rowing": "mechopt.studies.kinds.rowing:problem_from_study",
     "flexible-slider-crank": "mechopt.studies.kinds.flexible_slider_crank:problem_from_study",
     "flexible-four-bar": "mechopt.studies.kinds.flexible_four_bar:problem_from_study",
+    "path-synthesis": "mechopt.studies.kinds.path_synthesis:problem_from_study",
     "external": "mechopt.studies.kinds.external:problem_from_study",
 }
 

@@ -8,7 +8,11 @@
   et al. 2019); the last tenth of the budget minimises the local model's mean around the best design of any
   restart (a final polish).
 
-Both start from a scrambled Sobol design of 2d + 2 points (fewer when the budget is short, so that at least a
+* ``least-squares`` (any d, when the problem declares residuals): Gauss-Newton runs on the residuals from the
+  starts that multi-level single linkage picks in a growing Sobol sample (:mod:`mechopt.optimize.least_squares`).
+  The residuals' Jacobian is a better local model than any GP of their sum, and the sample needs no model at all.
+
+All start from a scrambled Sobol design of 2d + 2 points (fewer when the budget is short, so that at least a
 quarter of it is left to the model): the smallest design that fixes a length-scale per variable with some margin.
 """
 
@@ -34,7 +38,7 @@ class Plan:
     Attributes
     ----------
     name : str
-        ``"global"`` or ``"trust-region"``.
+        ``"global"``, ``"trust-region"`` or ``"least-squares"``.
     n_init : int
         Space-filling designs simulated first.
     n_polish : int
@@ -50,14 +54,20 @@ class Plan:
 
     def describe(self, dim: int, budget: int) -> str:
         """One line for the result's message."""
-        what = ("one global GP, expected improvement" if self.name == "global"
-                else "expected improvement in a restarted trust region")
-        what += f", local polish of the last {self.n_polish}"
+        if self.name == "least-squares":
+            what = "Gauss-Newton runs on the residuals from multi-level single linkage starts"
+        else:
+            what = ("one global GP, expected improvement" if self.name == "global"
+                    else "expected improvement in a restarted trust region")
+            what += f", local polish of the last {self.n_polish}"
         return f"plan {self.name} (d = {dim}, budget {budget}): {self.n_init} Sobol designs, then {what}"
 
 
-def choose_plan(dim: int, budget: int, batch: int = 1) -> Plan:
-    """The plan for ``dim`` variables and ``budget`` simulations, ``batch`` designs a step."""
+def choose_plan(dim: int, budget: int, batch: int = 1, least_squares: bool = False) -> Plan:
+    """The plan for ``dim`` variables and ``budget`` simulations, ``batch`` designs a step; ``least_squares``: the
+    problem declares residuals."""
     n_init = min(2 * dim + 2, budget - max(1, budget // 4))
+    if least_squares:
+        return Plan("least-squares", n_init, 0, batch)
     n_polish = max(1, budget // 10) if budget - n_init > 2 else 0
     return Plan("global" if dim <= GLOBAL_MAX_DIM else "trust-region", n_init, n_polish, batch)

@@ -18,15 +18,20 @@ from scipy.stats import qmc
 from mechopt.optimize.auto.acquisition import propose_batch
 from mechopt.optimize.auto.feasibility import SuccessModel
 from mechopt.optimize.auto.gp import GaussianProcess, fit_gp
+from mechopt.optimize.auto.least_squares_plan import least_squares_plan
 from mechopt.optimize.auto.plan import Plan, choose_plan
 from mechopt.optimize.auto.polish import polish_on_constraints
 from mechopt.optimize.auto.transform import standardise
 from mechopt.optimize.auto.trust_region import TrustRegion
+from mechopt.runs.sample_record import KEY_DECIMALS
 
 __all__ = ["AutoResult", "auto_search"]
 
 #: ``evaluate(X) -> (n,)``: objective at designs X (n, d) in the variables' units; NaN where a simulation failed.
 BatchEvaluator = Callable[[np.ndarray], np.ndarray]
+#: ``evaluate(X) -> (values (n,), residuals)``: a least-squares problem's objective and residual vectors (None where
+#: the simulation failed).
+ResidualBatchEvaluator = Callable[[np.ndarray], tuple[np.ndarray, list]]
 #: ``feasible(X) -> bool (n,)``: designs satisfying the declared (cheap) constraints.
 Predicate = Callable[[np.ndarray], np.ndarray]
 
@@ -72,9 +77,14 @@ class _Run:
     """The designs simulated so far (unit cube), the door to the simulator and the model fits."""
 
     def __init__(self, evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, feasible: Predicate | None,
-                 rng: np.random.Generator, margins: Callable[[np.ndarray], np.ndarray] | None = None) -> None:
+                 rng: np.random.Generator, margins: Callable[[np.ndarray], np.ndarray] | None = None,
+                 residuals: ResidualBatchEvaluator | None = None) -> None:
         self.evaluate, self.budget, self.feasible, self.rng = evaluate, budget, feasible, rng
         self.margins = margins
+        #: A least-squares problem's evaluator, and the residual vector of every design simulated (None: failed).
+        self.residual_evaluate = residuals
+        self.R: list = []
+        self._index: dict[tuple, int] = {}
         self.lo, self.width = bounds[:, 0], bounds[:, 1] - bounds[:, 0]
         self.U = np.zeros((0, bounds.shape[0]))
         self.values = np.zeros(0)
@@ -111,8 +121,44 @@ class _Run:
     def simulate(self, U: np.ndarray) -> None:
         U = np.atleast_2d(U)[: self.remaining]
         if U.shape[0]:
-            values = np.asarray(self.evaluate(self.to_x(U)), dtype=float).reshape(-1)
+            if self.residual_evaluate is None:
+                values = np.asarray(self.evaluate(self.to_x(U)), dtype=float).reshape(-1)
+            else:
+                values, R = self.residual_evaluate(self.to_x(U))
+                values = np.asarray(values, dtype=float).reshape(-1)
+                self.R.extend(None if r is None else np.asarray(r, dtype=float) for r in R)
             self.U, self.values = np.vstack([self.U, U]), np.concatenate([self.values, values])
+
+    def declared(self, U: np.ndarray) -> np.ndarray:
+        """Designs inside the unit cube that satisfy the declared constraints (simulated before or not)."""
+        U = np.atleast_2d(U)
+        ok = np.all((U >= 0.0) & (U <= 1.0), axis=1)
+        if self.feasible is not None and ok.any():
+            ok[ok] = self.feasible(self.to_x(U[ok]))
+        return ok
+
+    def residuals_at(self, U: np.ndarray) -> tuple[np.ndarray, list]:
+        """Objective and residuals at designs U (unit cube), simulating those not simulated yet; only the leading
+        rows the budget allows are returned."""
+        U = np.atleast_2d(U)
+        index = self._find(U)
+        # One of each design the sample store cannot tell apart (its key: KEY_DECIMALS decimals in the variables'
+        # units); the designs themselves are simulated as given, so that a design on a constraint stays on it.
+        new = {self._key(u): u for u in U[index < 0]}
+        self.simulate(np.array(list(new.values())).reshape(-1, U.shape[1]))
+        index = self._find(U)
+        n = int(np.argmax(index < 0)) if (index < 0).any() else U.shape[0]
+        return self.values[index[:n]], [self.R[i] for i in index[:n]]
+
+    def _find(self, U: np.ndarray) -> np.ndarray:
+        """Index of each design of U among those simulated, to the store's resolution (-1: not simulated)."""
+        if len(self._index) < self.U.shape[0]:
+            for i in range(len(self._index), self.U.shape[0]):
+                self._index.setdefault(self._key(self.U[i]), i)
+        return np.array([self._index.get(self._key(u), -1) for u in U], dtype=int)
+
+    def _key(self, u: np.ndarray) -> tuple:
+        return tuple(np.round(self.lo + u * self.width, KEY_DECIMALS).tolist())
 
     def fill(self, U: np.ndarray, k: int) -> np.ndarray:
         """``U`` topped up to ``k`` designs with allowed random ones (a proposal found too few in its box)."""
@@ -153,6 +199,8 @@ class _Run:
 def _initial_design(run: _Run, n: int) -> np.ndarray:
     """The first ``n`` allowed points of a scrambled Sobol sequence (rejection of the declared constraints)."""
     d = run.U.shape[1]
+    if n <= 0:
+        return np.zeros((0, d))
     sobol = qmc.Sobol(d, seed=run.rng)
     chosen = np.zeros((0, d))
     for _ in range(20):
@@ -251,7 +299,9 @@ def _limited_threads() -> contextlib.AbstractContextManager:
 
 def auto_search(evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, seed: int = 0,
                 feasible: Predicate | None = None, batch: int = 1,
-                margins: Callable[[np.ndarray], np.ndarray] | None = None) -> AutoResult:
+                margins: Callable[[np.ndarray], np.ndarray] | None = None,
+                residuals: ResidualBatchEvaluator | None = None, fd_step: float = 1e-5,
+                initial: np.ndarray | None = None) -> AutoResult:
     """Minimise a simulator within ``budget`` simulations on the plan of :func:`choose_plan`.
 
     Parameters
@@ -271,6 +321,14 @@ def auto_search(evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, seed:
     margins : callable, optional
         ``margins(X) -> (n, c)``: the declared constraints' margins (>= 0 feasible), for the final polish onto an
         active constraint.
+    residuals : callable, optional
+        A least-squares problem: ``residuals(X) -> (values, list of residual vectors or None)``, used instead of
+        ``evaluate``; the plan is then ``least-squares``.
+    fd_step : float
+        Forward-difference step of the Gauss-Newton runs, as a fraction of each variable's range.
+    initial : (m, d) ndarray, optional
+        Designs simulated before (by another method, found again in the sample store): they join the model on top
+        of ``budget`` and stand in for as many of the Sobol designs.
 
     Returns
     -------
@@ -278,14 +336,24 @@ def auto_search(evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, seed:
     """
     bounds = np.asarray(bounds, dtype=float)
     d = bounds.shape[0]
-    plan = choose_plan(d, int(budget), int(batch))
-    run = _Run(evaluate, bounds, int(budget), feasible, np.random.default_rng(seed), margins)
+    plan = choose_plan(d, int(budget), int(batch), least_squares=residuals is not None)
+    run = _Run(evaluate, bounds, int(budget), feasible, np.random.default_rng(seed), margins, residuals)
     run.prior = plan.name == "trust-region"
     with _limited_threads():
-        run.simulate(_initial_design(run, plan.n_init))
-        if run.ok.sum() < 2:
+        n_init = plan.n_init
+        if initial is not None and len(initial):
+            U0 = (np.atleast_2d(np.asarray(initial, dtype=float)) - run.lo) / run.width
+            run.budget += U0.shape[0]
+            run.simulate(U0)
+            n_init = max(0, n_init - int(run.ok.sum()))
+        run.simulate(_initial_design(run, n_init))
+        if run.ok.sum() < 2 and plan.name != "least-squares":
             run.simulate(_initial_design(run, run.remaining))
-        (_global_plan if plan.name == "global" else _trust_region_plan)(run, plan)
+        if plan.name == "least-squares":
+            unit_margins = None if margins is None else (lambda U: margins(run.to_x(U)))
+            least_squares_plan(run, plan.batch, fd_step, unit_margins)
+        else:
+            (_global_plan if plan.name == "global" else _trust_region_plan)(run, plan)
     nfailed = int((~run.ok).sum())
     if run.ok.any():
         i = run.best_index()

@@ -26,6 +26,7 @@ from mechopt.optimize.baselines.library import MissingLibraryError
 from mechopt.optimize.baselines.nelder_mead import minimize_nelder_mead
 from mechopt.optimize.baselines.nevergrad_optimizers import minimize_nevergrad_cma, minimize_nevergrad_ngopt
 from mechopt.optimize.baselines.optuna_samplers import minimize_optuna_cmaes, minimize_optuna_tpe
+from mechopt.optimize.baselines.paper000_hybrid import minimize_paper000_hybrid
 from mechopt.optimize.baselines.particle_swarm import minimize_particle_swarm
 from mechopt.optimize.baselines.powell_penalty import minimize_powell_penalty
 from mechopt.optimize.baselines.pymoo_algorithms import minimize_pymoo_de, minimize_pymoo_ga, minimize_pymoo_pso
@@ -53,6 +54,7 @@ __all__ = [
     "minimize_nevergrad_ngopt",
     "minimize_optuna_cmaes",
     "minimize_optuna_tpe",
+    "minimize_paper000_hybrid",
     "minimize_particle_swarm",
     "minimize_powell_penalty",
     "minimize_pymoo_de",
@@ -71,6 +73,7 @@ IN_HOUSE_BASELINES: dict[str, Callable[..., OptimizeResult]] = {
     "slsqp": minimize_slsqp,
     "powell_penalty": minimize_powell_penalty,
     "genetic": minimize_genetic,
+    "paper000_hybrid": minimize_paper000_hybrid,
     "sce_ua": minimize_sce_ua,
     "particle_swarm": minimize_particle_swarm,
     "bayesian": minimize_bayesian,
@@ -105,6 +108,9 @@ BASELINE_DOCS: dict[str, str] = {
     "sequence of quadratic exterior penalties (paper 001).",
     "genetic": "real-coded GA, tournament + SBX + polynomial mutation + elitism (Deb 2001), then multistart "
     "Nelder-Mead/SLSQP from its best designs (hybrid of paper 000); static quadratic penalty.",
+    "paper000_hybrid": "paper 000's hybrid: GA on the dimensions (feasible initial population, SBX, polynomial "
+    "mutation, 5 % elitism; λ = 50 quadratic penalty, infeasible children not simulated), then SLSQP from its 100 "
+    "best distinct designs.",
     "sce_ua": "shuffled complex evolution (Duan, Sorooshian & Gupta 1992), best of paper 004; feasible-space "
     "rejection with random resampling.",
     "particle_swarm": "global-best PSO with inertia/constriction coefficients (Clerc & Kennedy 2002); "

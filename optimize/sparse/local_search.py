@@ -16,7 +16,23 @@ from scipy.optimize import OptimizeResult, minimize
 
 from mechopt.optimize.budget import CountedProblem
 
-__all__ = ["feasible_side_gradient", "local_slsqp"]
+__all__ = ["feasible_side_gradient", "gradient_designs", "local_slsqp"]
+
+
+def gradient_designs(problem: CountedProblem, x: np.ndarray, step: float = 1e-5) -> tuple[list[np.ndarray], list[bool]]:
+    """The d designs :func:`feasible_side_gradient` asks for at ``x`` (and whether each is the forward one): known
+    before any simulation, so that they can be simulated together (issue 28)."""
+    x = np.asarray(x, dtype=float)
+    points, forward_side = [], []
+    for i in range(x.size):
+        h = step * problem.span[i]
+        forward, backward = x.copy(), x.copy()
+        forward[i] += h
+        backward[i] -= h
+        forward_side.append(bool(problem.feasible(forward) or not problem.feasible(backward)
+                                 and forward[i] <= problem.upper[i]))
+        points.append(forward if forward_side[-1] else backward)
+    return points, forward_side
 
 
 def feasible_side_gradient(
@@ -40,17 +56,17 @@ def feasible_side_gradient(
         Gradient in design units; a coordinate whose both neighbours are infeasible uses the forward step.
     """
     x = np.asarray(x, dtype=float)
+    points, forward_side = gradient_designs(problem, x, step)
+    prefetch = getattr(problem, "prefetch", None)
+    if prefetch is not None:
+        # A problem that can simulate several designs at once gets the d + 1 designs of the gradient together
+        # (issue 28); the calls below then find them.
+        prefetch(np.vstack([x, *points]))
     f0 = fun(x)
     g = np.zeros(x.size)
     for i in range(x.size):
         h = step * problem.span[i]
-        forward, backward = x.copy(), x.copy()
-        forward[i] += h
-        backward[i] -= h
-        if problem.feasible(forward) or not problem.feasible(backward) and forward[i] <= problem.upper[i]:
-            g[i] = (fun(forward) - f0) / h
-        else:
-            g[i] = (f0 - fun(backward)) / h
+        g[i] = (fun(points[i]) - f0) / h if forward_side[i] else (f0 - fun(points[i])) / h
     return g
 
 

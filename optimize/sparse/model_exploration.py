@@ -34,6 +34,8 @@ __all__ = ["DISTANCE_CYCLE", "corrected_model", "explore"]
 DISTANCE_CYCLE = (0.2, 0.1, 0.05, 0.0)
 #: Candidate designs per step and dimension, over the whole region and around the best design.
 _CLOUD_GLOBAL, _CLOUD_LOCAL = 1000, 300
+#: Candidates a step after the first of a round is chosen among (the best of the honest corrected model).
+_LIAR_CANDIDATES = 512
 #: Spreads (fraction of the box) of the clouds around the best design.
 _LOCAL_SIGMAS = (0.02, 0.08)
 
@@ -85,8 +87,9 @@ def corrected_model(trend: Callable[[np.ndarray], np.ndarray] | None, Z: np.ndar
 def explore(simulate: Callable[[np.ndarray], float], Z: np.ndarray, q: np.ndarray,
             trend: Callable[[np.ndarray], np.ndarray] | None, feasible: Callable[[np.ndarray], np.ndarray],
             n_steps: int, seed: int = 0, cycle: tuple[float, ...] = DISTANCE_CYCLE,
-            margins: Callable[[np.ndarray], np.ndarray] | None = None,
-            patience: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+            margins: Callable[[np.ndarray], np.ndarray] | None = None, patience: int | None = None,
+            batch: int = 1, simulate_batch: Callable[[np.ndarray], np.ndarray] | None = None
+            ) -> tuple[np.ndarray, np.ndarray]:
     """Take ``n_steps`` simulations on the corrected model (see the module docstring), in the unit cube.
 
     Parameters
@@ -103,25 +106,28 @@ def explore(simulate: Callable[[np.ndarray], float], Z: np.ndarray, q: np.ndarra
         Feasibility of unit-cube designs (n, d) -> (n,) bool: every step is feasible.
     n_steps : int
         Simulations to take.
-    seed : int
-        Seed of the candidate clouds.
-    cycle : tuple of float
-        Distances (fraction of the box) cycled through, wide to none.
+    seed, cycle : int, tuple of float
+        Seed of the candidate clouds; distances (fraction of the box) cycled through, wide to none.
     margins : callable, optional
         Constraint margins of unit-cube designs (n, d) -> (n, m), >= 0 feasible.  With them a step at distance 0
         polishes the cloud's best by SLSQP on the corrected model (model calls only, no simulation).
     patience : int, optional
         Stop after this many steps in a row that did not improve on the best value.
+    batch : int
+        Steps proposed and simulated at once (issue 28; :func:`_batch_round`); 1 (default): one at a time.
+    simulate_batch : callable, optional
+        Values of unit-cube designs (k, d) -> (k,) simulated together (default: ``simulate`` on each).
 
     Returns
     -------
-    Z : (n + k, d) ndarray
-        Every design, the earlier ones first.
-    q : (n + k,) ndarray
-        Their values.
+    Z, q : (n + k, d) and (n + k,) ndarrays
+        Every design, the earlier ones first, and their values.
     """
     Z = np.atleast_2d(np.asarray(Z, dtype=float))
     q = np.asarray(q, dtype=float).reshape(-1)
+    if batch > 1:
+        return _explore_batches(simulate_batch or (lambda Zb: np.array([simulate(z) for z in Zb], dtype=float)),
+                                Z, q, trend, feasible, n_steps, seed, cycle, margins, patience, batch)
     d = Z.shape[1]
     rng = np.random.default_rng(seed)
     sobol = qmc.Sobol(d, seed=rng)
@@ -157,6 +163,107 @@ def explore(simulate: Callable[[np.ndarray], float], Z: np.ndarray, q: np.ndarra
         Z, q = np.vstack([Z, z]), np.append(q, value)
         idle = 0 if value < best_before else idle + 1
     return Z, q
+
+
+def _explore_batches(simulate_batch: Callable[[np.ndarray], np.ndarray], Z: np.ndarray, q: np.ndarray,
+                     trend: Callable[[np.ndarray], np.ndarray] | None, feasible: Callable[[np.ndarray], np.ndarray],
+                     n_steps: int, seed: int, cycle: tuple[float, ...],
+                     margins: Callable[[np.ndarray], np.ndarray] | None, patience: int | None,
+                     batch: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`explore` in rounds of ``batch`` steps simulated together (see :func:`_batch_round`).
+
+    Patience counts steps, as one at a time: a round that brings nothing better adds its size to the idle count.
+    """
+    d = Z.shape[1]
+    rng = np.random.default_rng(seed)
+    sobol = qmc.Sobol(d, seed=rng)
+    n_global = 2 ** int(np.ceil(np.log2(_CLOUD_GLOBAL * d)))
+    idle, taken = 0, 0
+    while taken < int(n_steps):
+        if patience is not None and idle >= patience:
+            break
+        ok = np.isfinite(q)
+        if ok.sum() < d + 2:
+            break
+        k = min(batch, int(n_steps) - taken)
+        chosen = _batch_round(Z, q, trend, feasible, margins, sobol, rng, n_global, cycle, taken, k)
+        taken += k  # a step with no candidate at its distance is spent, as one at a time
+        if not chosen:
+            continue
+        Zb = np.array(chosen)
+        values = np.asarray(simulate_batch(Zb), dtype=float).reshape(-1)
+        best_before = np.min(q[ok])
+        Z, q = np.vstack([Z, Zb]), np.append(q, values)
+        improved = np.isfinite(values).any() and np.nanmin(values) < best_before
+        idle = 0 if improved else idle + len(chosen)
+    return Z, q
+
+
+def _batch_round(Z: np.ndarray, q: np.ndarray, trend: Callable[[np.ndarray], np.ndarray] | None,
+                 feasible: Callable[[np.ndarray], np.ndarray], margins: Callable[[np.ndarray], np.ndarray] | None,
+                 sobol: qmc.Sobol, rng: np.random.Generator, n_global: int, cycle: tuple[float, ...], step: int,
+                 k: int) -> list[np.ndarray]:
+    """Up to ``k`` steps to simulate together: the constant liar on the corrected model.
+
+    The steps of the round take the distances ``cycle[(step + j) % len(cycle)]``, j < k, as as many single steps
+    would, the smallest first, from every simulated design and every step already chosen; each chosen step is then
+    believed to return the best value so far (the lie), and the corrected model is refitted with it before the
+    next is chosen, so a step at distance 0 is not chosen twice in the same basin's bottom unless the model still
+    points there.  Not the kriging believer: with an interpolant, believing the model's own prediction leaves the
+    model unchanged, and the steps at distance 0 would pile up at one point.
+    """
+    d = Z.shape[1]
+    ok = np.isfinite(q)
+    Zf, qf = Z[ok], q[ok]
+    lie = float(np.min(qf))
+    best = Zf[np.argmin(qf)]
+    clouds = [sobol.random(n_global)]
+    for sigma in _LOCAL_SIGMAS:
+        clouds.append(np.clip(best + sigma * rng.standard_normal((_CLOUD_LOCAL * d, d)), 0.0, 1.0))
+    cloud = np.vstack(clouds)
+    cloud = cloud[np.asarray(feasible(cloud), dtype=bool)]
+    chosen: list[np.ndarray] = []
+    if cloud.shape[0] == 0:
+        return chosen
+    dist_simulated = cKDTree(Z).query(cloud)[0]
+    # The trend (the line model) is the same for every lie: at the cloud, computed once a round.
+    t_cloud = None if trend is None else np.asarray(trend(cloud), dtype=float)
+    memo: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+    def cached_trend(U: np.ndarray) -> np.ndarray:
+        hit = memo.get(id(U))
+        return hit[1] if hit is not None and hit[0] is U else trend(U)
+
+    def at(model: Callable[[np.ndarray], np.ndarray], idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        points = cloud[idx]
+        memo.clear()
+        if t_cloud is not None:
+            memo[id(points)] = (points, t_cloud[idx])
+        return points, model(points)
+
+    base_trend = None if trend is None else cached_trend
+    honest = corrected_model(base_trend, Zf, qf)
+    v0 = at(honest, np.arange(len(cloud)))[1]
+    # The closest first: the step at the corrected model's own minimum is chosen on the honest model, before any lie,
+    # and is the only one polished (a polish costs more model calls than the whole cloud; the lies are there to
+    # differ from it).  A lie changes the model near its design only: the others are chosen among the honest
+    # model's best candidates.
+    for delta in sorted(cycle[(step + j) % len(cycle)] for j in range(k)):
+        dist = dist_simulated if not chosen else np.minimum(dist_simulated, cKDTree(np.array(chosen)).query(cloud)[0])
+        idx = np.flatnonzero(dist >= max(delta, 1e-6))
+        if idx.size == 0:
+            continue
+        lies = np.array(chosen).reshape(-1, d)
+        if chosen:
+            model = corrected_model(base_trend, np.vstack([Zf, lies]), np.append(qf, np.full(len(lies), lie)))
+            points, values = at(model, idx[np.argsort(v0[idx])[:_LIAR_CANDIDATES]])
+        else:
+            model, points, values = honest, cloud[idx], v0[idx]
+        z = points[int(np.argmin(values))]
+        if delta == 0.0 and not chosen:
+            z = _polish(model, z, feasible, margins, Z)
+        chosen.append(z)
+    return chosen
 
 
 def _polish(model: Callable[[np.ndarray], np.ndarray], z0: np.ndarray, feasible: Callable[[np.ndarray], np.ndarray],

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
@@ -50,6 +51,19 @@ class Sampler:
         #: Every design of this run and its objective (NaN when failed), by key: what later steps model.
         self.history: dict[str, tuple[tuple[float, ...], float]] = {}
         self.sampling_time_s = 0.0
+        #: Rounds of simulations: calls that dispatched at least one design to the simulators (issue 28).
+        self.rounds = 0
+        #: Waves: a round of n designs on w workers is ceil(n / w) of them (the simulation time, in simulations).
+        self.waves = 0
+        #: Seconds the simulators spent on the designs this run dispatched (their recorded wall times summed).
+        self.busy_s = 0.0
+        self._started = time.perf_counter()
+
+    @property
+    def batch_size(self) -> int:
+        """Designs a method should propose at once: the executor's workers (local processes or the Dask cluster's
+        worker threads), at least 1; 1 in-process."""
+        return max(1, int(getattr(self.executor, "workers", 1) or 1))
 
     @property
     def executor_description(self) -> str:
@@ -66,6 +80,10 @@ class Sampler:
         res = sample_designs(asked, self.problem, self.store, fingerprint=self.fingerprint, executor=self.executor,
                              progress=self.progress, desc=desc)
         self.sampling_time_s += time.perf_counter() - t0
+        if res.n_computed + res.n_waited > 0:
+            self.rounds += 1
+            self.waves += math.ceil((res.n_computed + res.n_waited) / self.batch_size)
+            self.busy_s += res.compute_time_s
         # Counted once per distinct design of the run: a design asked again later is neither new nor reused.
         self.n_computed += res.n_computed
         self.n_waited += res.n_waited
@@ -86,8 +104,32 @@ class Sampler:
             self.history[design_key(design)] = (design, float(v))
         return values
 
+    def residuals(self, designs: np.ndarray, desc: str) -> tuple[np.ndarray, list]:
+        """The objective and the residual vector (None where the simulation did not succeed) at designs (n, d), for a
+        problem that declares :attr:`~mechopt.optimize.problem.DesignProblem.residuals`."""
+        values = self(designs, desc)
+        records = self.records(designs, desc)  # found in the store: nothing is simulated twice
+        return values, [self.problem.residual_vector(r.outputs) if np.isfinite(v) else None
+                        for r, v in zip(records, values, strict=True)]
+
+    def timing(self) -> dict:
+        """Rounds, waiting and the method's own time since this sampler was made (issue 28).
+
+        ``rounds``: calls that dispatched designs to the simulators; ``waves``: those calls in simulations one
+        after the other (a call of n designs on w workers is ceil(n / w) waves); ``waiting_s``: wall time inside
+        the calls (the run waited for simulations); ``method_s``: the rest of the wall time (the method's own
+        computing); ``idle_share``: the share of the workers' time (``batch_size`` × wall time) not spent
+        simulating.
+        """
+        wall = time.perf_counter() - self._started
+        capacity = self.batch_size * wall
+        idle = 1.0 - self.busy_s / capacity if capacity > 0 else 0.0
+        return {"rounds": self.rounds, "waves": self.waves, "workers": self.batch_size, "wall_s": wall,
+                "waiting_s": self.sampling_time_s, "method_s": max(0.0, wall - self.sampling_time_s),
+                "busy_s": self.busy_s, "idle_share": min(1.0, max(0.0, idle))}
+
     def summary(self) -> dict:
         """Counts for result.json and the final log line."""
         return {"distinct_designs": len(self.designs), "new": self.n_computed, "reused": self.n_cached,
                 "waited_for_other_runs": self.n_waited, "failed": len(self.failures),
-                "executor": self.executor_description}
+                "executor": self.executor_description, **self.timing()}

@@ -59,7 +59,8 @@ class TrustRegionResult:
 def trust_region_steps(model: Callable[[np.ndarray], np.ndarray], simulate: Callable[[np.ndarray], float],
                        feasible: Callable[[np.ndarray], np.ndarray], box: np.ndarray, X: np.ndarray, q: np.ndarray,
                        budget: int, seed: int = 0,
-                       margins: Callable[[np.ndarray], np.ndarray] | None = None) -> TrustRegionResult:
+                       margins: Callable[[np.ndarray], np.ndarray] | None = None, batch: int = 1,
+                       simulate_batch: Callable[[np.ndarray], np.ndarray] | None = None) -> TrustRegionResult:
     """Minimise a simulated quantity by steps on the corrected model, within ``budget`` simulations.
 
     Parameters
@@ -80,6 +81,10 @@ def trust_region_steps(model: Callable[[np.ndarray], np.ndarray], simulate: Call
         Seed of the candidate points inside each region.
     margins : callable, optional
         Constraint margins of one design (d,) -> (m,), >= 0 when feasible, for the polish of each step.
+    batch : int
+        Steps proposed at once (the free workers, issue 28; :meth:`_Steps.batch_step`); 1 (default): one at a time.
+    simulate_batch : callable, optional
+        The fitted quantity of designs (k, d) -> (k,), simulated together (default: ``simulate`` on each).
 
     Returns
     -------
@@ -96,8 +101,10 @@ def trust_region_steps(model: Callable[[np.ndarray], np.ndarray], simulate: Call
         return TrustRegionResult(x=np.full(lower.size, np.nan), value=float("nan"), n_steps=0, radius=0.0)
     best = int(np.flatnonzero(inside)[np.argmin(q[inside])])
     steps = _Steps(model, simulate, feasible, lower, span, (X - lower) / span, q, best, seed, margins)
+    steps.simulate_batch = simulate_batch or (lambda Xb: np.array([simulate(x) for x in Xb], dtype=float))
     while steps.n_steps < budget and steps.radius >= RADIUS_MIN:
-        if not steps.step(budget):
+        k = min(int(batch), budget - steps.n_steps)
+        if not (steps.step(budget) if k <= 1 else steps.batch_step(budget, k)):
             break
     return TrustRegionResult(x=lower + steps.u_best * span, value=steps.q_best, n_steps=steps.n_steps,
                              radius=steps.radius)
@@ -145,13 +152,16 @@ class _Steps:
 
         return corrected
 
-    def proposal(self, corrected: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
-        """The best feasible local minimum of the corrected model in the region around the best design."""
-        lo, hi = np.maximum(self.u_best - self.radius, 0.0), np.minimum(self.u_best + self.radius, 1.0)
+    def proposal(self, corrected: Callable[[np.ndarray], np.ndarray], radius: float | None = None,
+                 starts: int = 3) -> np.ndarray:
+        """The best feasible local minimum of the corrected model in the region (half-width ``radius``, default
+        the current one) around the best design, polished from its ``starts`` best cloud points."""
+        radius = self.radius if radius is None else radius
+        lo, hi = np.maximum(self.u_best - radius, 0.0), np.minimum(self.u_best + radius, 1.0)
         cloud = lo + self.sobol.random(512) * (hi - lo)
         cloud = np.vstack([self.u_best, cloud[np.asarray(self.feasible(self.lower + cloud * self.span), dtype=bool)]])
         values = corrected(cloud)
-        return _polish(corrected, cloud[np.argsort(values)[:3]], lo, hi, self.lower, self.span, self.margins,
+        return _polish(corrected, cloud[np.argsort(values)[:starts]], lo, hi, self.lower, self.span, self.margins,
                        self.feasible)
 
     def run(self, u: np.ndarray) -> float:
@@ -195,6 +205,98 @@ class _Steps:
         elif ratio < SHRINK:
             self.radius *= 0.5
         return True
+
+    def run_many(self, Uc: np.ndarray) -> np.ndarray:
+        """Simulate unit-cube designs (k, d) together (counted); the finite values join the simulated designs."""
+        values = np.asarray(self.simulate_batch(self.lower + Uc * self.span), dtype=float).reshape(-1)
+        self.n_steps += len(Uc)
+        ok = np.isfinite(values)
+        self.U, self.q = np.vstack([self.U, Uc[ok]]), np.append(self.q, values[ok])
+        return values
+
+    def batch_proposals(self, corrected: Callable[[np.ndarray], np.ndarray], here: float,
+                        k: int) -> tuple[list[np.ndarray], list[float]]:
+        """Up to ``k`` steps at once: regions of half-width r, r/2, r/4, r/8 in turn (the shrinking a failed step
+        would cause, tried at the same time), each on the corrected model with the steps already chosen believed
+        to return the best value so far (the constant liar, so that two steps of a round differ)."""
+        ladder = max(1, min(4, int(np.floor(np.log2(self.radius / RADIUS_MIN))) + 1))
+        chosen: list[np.ndarray] = []
+        radii: list[float] = []
+        model = corrected
+        for j in range(k):
+            radius = self.radius * 0.5 ** (j % ladder)
+            if chosen:
+                lies = np.array(chosen)
+                correction = residual_model(np.vstack([self.U, lies]), np.append(
+                    (self.q - self.base(self.U)) / self.scale, (self.q_best - self.base(lies)) / self.scale))
+
+                def model(Uc: np.ndarray, correction=correction) -> np.ndarray:
+                    Uc = np.atleast_2d(Uc)
+                    return self.base(Uc) / self.scale + correction(Uc)
+
+            # The lied proposals polish one start, not three: they are there to differ, and each costs the round time.
+            u = self.proposal(model, radius, starts=1 if chosen else 3)
+            if float(corrected(u)[0]) >= here - 1e-12 or np.max(np.abs(u - self.u_best)) < 1e-3 * radius:
+                continue
+            known = np.vstack([self.U, *chosen]) if chosen else self.U
+            if np.min(np.max(np.abs(known - u), axis=1)) < 1e-7:
+                continue
+            chosen.append(u)
+            radii.append(radius)
+        return chosen, radii
+
+    def batch_step(self, budget: int, k: int) -> bool:
+        """One round of ``k`` steps simulated together (:meth:`batch_proposals`); the best of them is the step, the
+        region takes its half-width and is resized by its ratio.  False when the steps should end."""
+        corrected = self.corrected_model()
+        here = float(corrected(self.u_best)[0])
+        chosen, radii = self.batch_proposals(corrected, here, k)
+        if not chosen:
+            self.radius *= 0.5
+            return True
+        Uc = np.array(chosen)
+        values = self.run_many(Uc)
+        if not np.isfinite(values).any() or np.nanmin(values) >= self.q_best:
+            self.radius = min(radii) * 0.5
+            return True
+        j = int(np.nanargmin(values))
+        predicted = float(corrected(Uc[j])[0])
+        ratio = (self.q_best - values[j]) / max((here - predicted) * self.scale, 1e-300)
+        step = Uc[j] - self.u_best
+        self.radius = radii[j]
+        on_edge = np.any(np.abs(step) > 0.9 * self.radius)
+        self.creeping = self.creeping + 1 if np.max(np.abs(step)) < CREEP else 0
+        self.u_best, self.q_best = Uc[j].copy(), float(values[j])
+        if self.creeping >= 2:
+            self.creeping = 0
+            return self.valley_batches(step, budget, k)
+        if ratio > GROW and on_edge:
+            self.radius = min(2.0 * self.radius, 0.5)
+        elif ratio < SHRINK:
+            self.radius *= 0.5
+        return True
+
+    def valley_batches(self, step: np.ndarray, budget: int, k: int) -> bool:
+        """:meth:`run_down_valley` with its doubling steps simulated ``k`` at a time: the best design moves along
+        them while they keep decreasing, as one at a time."""
+        factor, moved = 2.0, False
+        while self.n_steps < budget:
+            tries, u_try = [], self.u_best
+            for _ in range(min(k, budget - self.n_steps)):
+                u_try = u_try + factor * step
+                if (np.any(u_try < 0.0) or np.any(u_try > 1.0)
+                        or not self.feasible(self.lower + u_try[None, :] * self.span)[0]):
+                    break
+                tries.append(u_try)
+                factor *= 2.0
+            if not tries:
+                break
+            values = self.run_many(np.array(tries))
+            for u_try, value in zip(tries, values, strict=True):
+                if not np.isfinite(value) or value >= self.q_best:
+                    return moved
+                self.u_best, self.q_best, moved = u_try, float(value), True
+        return moved
 
     def run_down_valley(self, step: np.ndarray, budget: int) -> bool:
         """Doubling steps along ``step`` from the best design while the simulations keep decreasing.

@@ -8,7 +8,9 @@ spans every response the paper's six variables can produce (see README).  The ob
     f = w_D f(D) + w_V f(V) + w_A f(A),   f(R) = RMS(R − R*) / (max R − min R)   (Eq. 18),
 
 against the responses R* of a target design simulated by the same engine, so the global optimum is the target,
-f = 0.
+f = 0.  It is a least-squares problem (:attr:`residuals`): the output ``residuals`` holds, term after term (D, V, A),
+w_R (R_i − R*_i) / ((max R − min R) sqrt(N)), whose sum of squares over one term is (w_R f(R))², so
+f = Σ_R sqrt(Σ_i r_i²) and f = 0 exactly where every residual is 0.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ import numpy as np
 from mechopt.errors import InputError
 from mechopt.optimize.problem import DesignProblem, Variable
 from mechopt.sim.flexible import ENGINES, MM, FlexibleSliderCrank, Response, normalised_error, simulate
+from mechopt.sim.flexible.response import normalised_residuals
 
 __all__ = ["DEFAULT_BOUNDS", "FlexibleSliderCrankProblem"]
 
@@ -58,6 +61,10 @@ class FlexibleSliderCrankProblem(DesignProblem):
     objective = "f"
     # f is a weighted sum of RMS errors: a cone |δ| at the optimum, f² is smooth there (README: measured on a line)
     fit = "square"
+    #: the output holding the weighted, normalised per-instant differences of D, V and A (module docstring)
+    residuals = "residuals"
+    #: 2: evaluate returns the residuals (samples stored by version 1 lack them)
+    version = 2
 
     @property
     def fd_step(self) -> float:  # type: ignore[override]
@@ -142,11 +149,22 @@ class FlexibleSliderCrankProblem(DesignProblem):
         w_d, w_v, w_a = self.weights
         return {"f": w_d * f_d + w_v * f_v + w_a * f_a, "f_D": f_d, "f_V": f_v, "f_A": f_a}
 
-    def evaluate(self, x: np.ndarray) -> dict[str, float]:
-        """Simulate design ``x`` = (l2, l3, h) in mm; returns f, f_D, f_V, f_A and the rod's peak deflection (mm)."""
+    def response_residuals(self, r: Response) -> np.ndarray:
+        """The residuals of a response against the target: w_R (R − R*) / (range R sqrt(N)) for R = D, V, A in turn.
+
+        The square root of one term's sum of squares is w_R f(R), so their sum is f of :meth:`errors`.
+        """
+        ref = self.target()
+        return np.concatenate([w * normalised_residuals(getattr(r, k), getattr(ref, k))
+                               for w, k in zip(self.weights, ("D", "V", "A"), strict=True)])
+
+    def evaluate(self, x: np.ndarray) -> dict[str, Any]:
+        """Simulate design ``x`` = (l2, l3, h) in mm; returns f, f_D, f_V, f_A, the rod's peak deflection (mm) and
+        the residuals (:meth:`response_residuals`, a list)."""
         r = self.response(x)
         out: dict[str, Any] = self.errors(r)
         out["D_peak_mm"] = float(np.max(np.abs(r.D)) / MM)
+        out["residuals"] = self.response_residuals(r).tolist()
         return out
 
     # --- declaration ---------------------------------------------------------------------------------------------

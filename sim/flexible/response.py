@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Response", "normalised_error"]
+__all__ = ["Response", "normalised_error", "normalised_residuals"]
 
 
 @dataclass(frozen=True)
@@ -61,3 +61,26 @@ def normalised_error(R: np.ndarray, R_target: np.ndarray) -> float:
     if span <= 0.0:
         return 0.0 if rms == 0.0 else float("inf")
     return rms / span
+
+
+def normalised_residuals(R: np.ndarray, R_target: np.ndarray) -> np.ndarray:
+    """The per-instant residuals of Eq. 18: (R − R*) / ((max R − min R) sqrt(N)), so that their sum of squares is
+    :func:`normalised_error` squared (least-squares problems).
+
+    Parameters
+    ----------
+    R, R_target : ndarray (n,)
+        A design's response and the target response at the same instants (any unit, the same for both).
+
+    Returns
+    -------
+    ndarray (n,)
+        Dimensionless; zeros if the design's response is constant and equal to the target, ``inf`` where it is
+        constant and differs (as :func:`normalised_error`).
+    """
+    R = np.asarray(R, dtype=float)
+    diff = R - np.asarray(R_target, dtype=float)
+    span = float(np.max(R) - np.min(R))
+    if span <= 0.0:
+        return np.where(diff == 0.0, 0.0, np.inf)
+    return diff / (span * np.sqrt(diff.size))

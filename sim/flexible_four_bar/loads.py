@@ -31,7 +31,8 @@ __all__ = ["DRIVE_COLUMNS", "drive_table", "drive_tables", "euler_load_ratios", 
 
 #: Columns of a drive row: axial force coefficients c0 (N), c1 (N/m), c2 (N/m²), transverse acceleration of the
 #: link's first joint a⊥0 (m/s²), the link's angular acceleration α (rad/s²), its angular rate ω (rad/s), and the
-#: shift of c0 per unit moment of elastic inertia ∫ ρA s ẅ ds of this link and of the other one (1/m).
+#: shift of c0 per unit moment of elastic inertia ∫ ρA s ẅ ds of this link and of the other one (1/m); the same
+#: coefficients turn the chords' shortening δ̈ into the links' extra angular accelerations (:mod:`.modal`).
 DRIVE_COLUMNS = ("c0", "c1", "c2", "a_perp0", "alpha", "omega", "k_self", "k_other")
 
 

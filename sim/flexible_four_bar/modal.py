@@ -10,10 +10,18 @@ two links bend independently; each keeps its lowest ``n_modes`` modes (Eqs. 13-1
 
 Option ``geometric_stiffness`` adds what the linear model lacks and Exudyn's geometrically exact cable has: the
 geometric stiffness of each link's axial force N(s) (:mod:`.loads`; a time-varying coupling of the modes), its c0
-shifted by both links' elastic inertia ∫ ρA s ẅ ds (which changes the pin force at C: the only coupling of the two
-links), and the centrifugal softening −ρA ω² w of the rotating chord frame (the normal term of Eq. 1).  Both links
-share one RK4 step, set by the stiffer.  The
-mid-point paths are the rigid mid-points moved by the mid-span deflection along the chord's normal.
+shifted by both links' moments of inertia ∫ ρA s (Δα s + ẅ) ds (they change the pin force at C), the centrifugal
+softening −ρA ω² w of the rotating chord frame (the normal term of Eq. 1), and the turn of both chords as the
+links' bending shortens them: a chord is δ = ½ ∫ w'² ds shorter than its link, and the loop
+B + (l3 − δ3) e3 = O4 + (l4 − δ4) e4 then gives both links the extra angular accelerations Δα3, Δα4 of
+l3 Δα3 n3 − l4 Δα4 n4 = δ̈3 e3 − δ̈4 e4, each loading its link with −ρA Δα s.  δ is second order in w, but in the
+start transient the coupler rings at millimetres and δ̈3 ≈ ω1² δ3 shakes the follower, whose own deflection is a
+tenth of the coupler's.  The shift of c0 and δ̈ are taken from the full η̈ they change: near the Euler load the
+geometric term is a large share of Λ η, and the linear η̈ alone would be a spurious acceleration.  Without the
+chords' turn the engines part by 0.6 % of D4's range (Eq. 18) below a tenth of the Euler load, with a linear η̈ by
+11 % at 0.28; with both 0.15 % and 0.55 % (tests/sim/flexible_four_bar/test_four_bar_engines.py, README).
+Both links share one RK4 step, set by the stiffer.  The mid-point paths are the rigid mid-points moved by the
+mid-span deflection along the chord's normal.
 """
 
 from __future__ import annotations
@@ -45,12 +53,11 @@ def link_frequencies(link: FlexibleLink, length: float, n_elements: int, n_modes
 
 
 @njit(cache=True)
-def _accel(lam, beta, load, geo, row3, row4, geometric, e, v, out):
-    """η̈ of both links (arrays (2, n_modes)) into ``out``.
+def _accel(lam, beta, load, geo, inertia, row3, row4, geometric, e, v, g, out):
+    """η̈ of both links (arrays (2, n_modes)) into ``out``; ``g`` is scratch of the same shape.
 
-    Linear part η̈ = f − β Λ η̇ − Λ η with f = −(a⊥0 load[0] + α load[1]); with ``geometric``, minus the geometric
-    stiffness Σ_p c_p G_p η (c0 corrected by the elastic inertia's moments, :func:`_inertia_shift`) plus the
-    centrifugal softening ω² η (M-orthonormal modes).
+    Linear part η̈ = f − β Λ η̇ − Λ η with f = −(a⊥0 load[0] + α load[1]); with ``geometric``, the terms of
+    :func:`_geometric` (M-orthonormal modes; ``inertia`` holds each link's ∫ ρA s² ds about its first joint).
     """
     nm = lam.shape[1]
     for k in range(2):
@@ -58,26 +65,60 @@ def _accel(lam, beta, load, geo, row3, row4, geometric, e, v, out):
         for m in range(nm):
             out[k, m] = -(row[3] * load[k, 0, m] + row[4] * load[k, 1, m]) - beta * lam[k, m] * v[k, m] \
                 - lam[k, m] * e[k, m]
-    if not geometric:
-        return
-    # ∫ ρA s ẅ ds of each link, from the linear accelerations (the geometric part is a few % of them)
-    s3 = s4 = 0.0
-    for m in range(nm):
-        s3 += load[0, 1, m] * out[0, m]
-        s4 += load[1, 1, m] * out[1, m]
-    for k in range(2):
-        row = row3 if k == 0 else row4
-        shift = row[6] * (s3 if k == 0 else s4) + row[7] * (s4 if k == 0 else s3)
-        for m in range(nm):
-            acc = row[5] * row[5] * e[k, m]
-            for n in range(nm):
-                acc -= ((row[0] + shift) * geo[k, 0, m, n] + row[1] * geo[k, 1, m, n] + row[2] * geo[k, 2, m, n]) \
-                    * e[k, n]
-            out[k, m] += acc
+    if geometric:
+        _geometric(load, geo, inertia, row3, row4, e, v, g, out)
 
 
 @njit(cache=True)
-def _integrate(lam, beta, load, geo, drive3, drive4, geometric, n_sub, dt, n_out):
+def _geometric(load, geo, inertia, row3, row4, e, v, g, out):
+    """Add to the linear η̈ in ``out``: the centrifugal softening ω² η, minus the geometric stiffness
+    (c0 + Δc0) G0 η + c1 G1 η + c2 G2 η, minus the load Δα load[1] of the chords' turn as they shorten (module
+    docstring).
+
+    Δc0 follows from each link's moment of inertia ∫ ρA s (Δα s + ẅ) ds (columns k_self, k_other) and Δα from the
+    chords' δ̈ = η̇ᵀ G0 η̇ + ηᵀ G0 η̈ (the same columns invert the loop's 2 × 2 system); both are taken from the η̈
+    they change (a small linear system, solved by fixed-point iteration): near the Euler load the geometric term
+    is a large part of Λ η, and the linear η̈ alone would put a spurious inertia into Δc0.  The Coriolis term
+    2 δ̇ ω / l of the shortening chord is left out: the material points' own axial drift u̇ ≈ −δ̇ s / l gives the
+    opposite load 2 ω u̇, and adding the one without the other moved the worst design away from Exudyn (measured).
+    """
+    nm = out.shape[1]
+    sums = np.zeros((2, 6))  # p = Σ L1 a, q = Σ L1 g, r = Σ L1², u = η̇ᵀG0η̇ + Σ g a, w = Σ g², x = Σ g L1
+    for k in range(2):
+        row = row3 if k == 0 else row4
+        for m in range(nm):
+            acc = row[5] * row[5] * e[k, m]
+            g[k, m] = 0.0
+            for n in range(nm):
+                acc -= (row[0] * geo[k, 0, m, n] + row[1] * geo[k, 1, m, n] + row[2] * geo[k, 2, m, n]) * e[k, n]
+                g[k, m] += geo[k, 0, m, n] * e[k, n]
+                sums[k, 3] += geo[k, 0, m, n] * v[k, m] * v[k, n]
+            out[k, m] += acc
+        for m in range(nm):
+            l1 = load[k, 1, m]
+            sums[k, 0] += l1 * out[k, m]
+            sums[k, 1] += l1 * g[k, m]
+            sums[k, 2] += l1 * l1
+            sums[k, 3] += g[k, m] * out[k, m]
+            sums[k, 4] += g[k, m] * g[k, m]
+            sums[k, 5] += g[k, m] * l1
+    shift3 = shift4 = da3 = da4 = 0.0
+    for _ in range(8):
+        s3 = sums[0, 0] - shift3 * sums[0, 1] + da3 * (inertia[0] - sums[0, 2])  # ∫ ρA s (Δα s + ẅ) ds
+        s4 = sums[1, 0] - shift4 * sums[1, 1] + da4 * (inertia[1] - sums[1, 2])
+        dd3 = sums[0, 3] - shift3 * sums[0, 4] - da3 * sums[0, 5]
+        dd4 = sums[1, 3] - shift4 * sums[1, 4] - da4 * sums[1, 5]
+        shift3 = row3[6] * s3 + row3[7] * s4
+        shift4 = row4[6] * s4 + row4[7] * s3
+        da3 = row3[6] * dd3 + row4[7] * dd4
+        da4 = row3[7] * dd3 + row4[6] * dd4
+    for m in range(nm):
+        out[0, m] -= shift3 * g[0, m] + da3 * load[0, 1, m]
+        out[1, m] -= shift4 * g[1, m] + da4 * load[1, 1, m]
+
+
+@njit(cache=True)
+def _integrate(lam, beta, load, geo, inertia, drive3, drive4, geometric, n_sub, dt, n_out):
     """Classical RK4 of both links from rest; ``drive3``, ``drive4`` hold the rows at every half step.
 
     Returns η (n_out, 2, n_modes) at every ``n_sub``-th step.
@@ -90,9 +131,10 @@ def _integrate(lam, beta, load, geo, drive3, drive4, geometric, n_sub, dt, n_out
     kx = np.zeros((4, 2, nm))
     e = np.zeros((2, nm))
     v = np.zeros((2, nm))
+    g = np.zeros((2, nm))
     for j in range((n_out - 1) * n_sub):
         kx[0] = vel
-        _accel(lam, beta, load, geo, drive3[2 * j], drive4[2 * j], geometric, eta, vel, ka[0])
+        _accel(lam, beta, load, geo, inertia, drive3[2 * j], drive4[2 * j], geometric, eta, vel, g, ka[0])
         for stage in range(3):
             w = dt if stage == 2 else 0.5 * dt
             for k in range(2):  # explicit loops: array expressions would allocate at every stage
@@ -101,7 +143,7 @@ def _integrate(lam, beta, load, geo, drive3, drive4, geometric, n_sub, dt, n_out
                     v[k, m] = vel[k, m] + w * ka[stage, k, m]
                     kx[stage + 1, k, m] = v[k, m]
             h = 2 * j + (2 if stage == 2 else 1)
-            _accel(lam, beta, load, geo, drive3[h], drive4[h], geometric, e, v, ka[stage + 1])
+            _accel(lam, beta, load, geo, inertia, drive3[h], drive4[h], geometric, e, v, g, ka[stage + 1])
         for k in range(2):
             for m in range(nm):
                 eta[k, m] += dt / 6.0 * (kx[0, k, m] + 2.0 * kx[1, k, m] + 2.0 * kx[2, k, m] + kx[3, k, m])
@@ -134,8 +176,9 @@ def _bend(p: FlexibleFourBar, t: np.ndarray, s3: np.ndarray, s4: np.ndarray) -> 
     halves = np.arange(2 * (p.n_samples - 1) * n_sub + 1) * (0.5 * dt)
     masses = (p.coupler.mass_per_length * p.l3, p.follower.mass_per_length * p.l4)
     drives = drive_tables(p.lengths, p.omega, p.branch, masses, halves)
+    inertia = np.array([masses[0] * p.l3**2 / 3.0, masses[1] * p.l4**2 / 3.0])  # ∫ ρA s² ds
     eta = _integrate(lam, float(p.beta), np.ascontiguousarray(np.stack([m[3] for m in modes])),
-                     np.ascontiguousarray(np.stack([m[4] for m in modes])), drives[0], drives[1],
+                     np.ascontiguousarray(np.stack([m[4] for m in modes])), inertia, drives[0], drives[1],
                      bool(p.geometric_stiffness), n_sub, dt, p.n_samples)
     out = []
     for k, (rm, _, phi, _, _) in enumerate(modes):

@@ -102,9 +102,9 @@ class FlexibleFourBar:
         Bending modes per link kept by the modal engine (3: the fourth is antisymmetric and leaves the mid-span
         deflection unchanged; 3 modes and 8 elements agree with 8 modes and 16 elements to 2e-4 of its range).
     geometric_stiffness : bool
-        Modal engine only: add the geometric stiffness of each link's quasi-static axial force and the centrifugal
-        softening of its rotating frame (not in the paper's linear model; Exudyn's geometrically exact cable has
-        both by construction).
+        Modal engine only: add the geometric stiffness of each link's axial force, the centrifugal softening of its
+        rotating frame and the turn of the chords as the bending shortens them (not in the paper's linear model;
+        Exudyn's geometrically exact cable has them by construction).
     branch : int
         +1: C on the left of the diagonal B → O4 (above the frame at t = 0); −1 the other assembly.
     """

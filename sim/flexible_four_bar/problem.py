@@ -8,7 +8,9 @@ response the twelve can give; the twelve-variable problem has a 6-dimensional va
 
 The objective is the paper's Eq. 25 read as five unweighted terms (:mod:`.response`) against the responses of a
 target design simulated by the same engine, so the global optimum is known: f = 0 at the target.  Constraints: the
-crank-rocker inequalities of Eq. 26 (mm), l1 + l3 − l2 − l4, l1 + l4 − l2 − l3, l3 + l4 − l1 − l2 >= 0.
+crank-rocker inequalities of Eq. 26 (mm), l1 + l3 − l2 − l4, l1 + l4 − l2 − l3, l3 + l4 − l1 − l2 >= 0.  It is a
+least-squares problem (:attr:`residuals`): the output ``residuals`` holds the five terms' normalised per-instant
+differences (:func:`.response.residuals`), f = Σ_k sqrt(Σ_{i in term k} r_i²).
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from mechopt.sim.flexible_four_bar.kinematics import crank_rocker_margins
 from mechopt.sim.flexible_four_bar.loads import euler_load_ratios
 from mechopt.sim.flexible_four_bar.parameters import MM, FlexibleFourBar
 from mechopt.sim.flexible_four_bar.response import FourBarResponse, five_term_error
+from mechopt.sim.flexible_four_bar.response import residuals as term_residuals
 from mechopt.sim.flexible_four_bar.simulate import ENGINES, simulate
 
 __all__ = ["ALL_VARIABLES", "IDENTIFIABLE", "PAPER_BOUNDS", "TARGET", "FlexibleFourBarProblem"]
@@ -85,11 +88,15 @@ class FlexibleFourBarProblem(DesignProblem):
     """
 
     constraints = ("crank_rocker_1", "crank_rocker_2", "crank_rocker_3")
-    outputs = ("f", "f_crank", "f_coupler", "f_follower", "f_D3", "f_D4")
+    outputs = ("f", "f_crank", "f_coupler", "f_follower", "f_D3", "f_D4", "kappa3", "kappa4")
     objective = "f"
     output_units = {"kappa3": "m⁴/s²", "kappa4": "m⁴/s²", "D3_peak_mm": "mm", "D4_peak_mm": "mm"}  # noqa: RUF012
     # a sum of RMS errors is a cone |δ| at the optimum; its square is smooth there (as in the slider-crank study)
     fit = "square"
+    #: the output holding the five terms' normalised per-instant differences (:func:`.response.residuals`)
+    residuals = "residuals"
+    #: 2: evaluate returns the residuals, and the modal engine's geometric terms turn the chords as they shorten
+    version = 2
 
     def __init__(self, bounds: Mapping[str, tuple[float, float]] | None = None,
                  fixed: Mapping[str, float] | None = None, target: Mapping[str, float] | None = None,
@@ -148,12 +155,14 @@ class FlexibleFourBarProblem(DesignProblem):
             self._target = simulate(four_bar_of(self.target_values, self.base), self.engine)
         return self._target
 
-    def evaluate(self, x: np.ndarray) -> dict[str, float]:
-        """Simulate design ``x``: f and its five terms (Eq. 25), both links' κ (m⁴/s²), peak deflections (mm) and
-        largest compression over the Euler load (:func:`.loads.euler_load_ratios`: the linear model's validity)."""
+    def evaluate(self, x: np.ndarray) -> dict[str, Any]:
+        """Simulate design ``x``: f and its five terms (Eq. 25), both links' κ (m⁴/s²), peak deflections (mm),
+        largest compression over the Euler load (:func:`.loads.euler_load_ratios`: the linear model's validity) and
+        the residuals (:func:`.response.residuals`, a list)."""
         p = self.parameters(x)
         r = simulate(p, self.engine)
         out: dict[str, Any] = five_term_error(r, self.target())
+        out["residuals"] = term_residuals(r, self.target()).tolist()
         ratio3, ratio4 = euler_load_ratios(p)
         out.update(kappa3=p.coupler.kappa, kappa4=p.follower.kappa, D3_peak_mm=float(np.max(np.abs(r.D3)) / MM),
                    D4_peak_mm=float(np.max(np.abs(r.D4)) / MM), load_ratio3=ratio3, load_ratio4=ratio4)

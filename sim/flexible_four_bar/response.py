@@ -6,6 +6,7 @@ the N instants of the difference to the target normalised by the candidate respo
     f = f_cr + f_co + f_fo + f(D3) + f(D4),   f_k = sqrt(1/N Σ_i [(Δx_i / R_x)² + (Δy_i / R_y)²]) for a path,
 
 with R_x = max x − min x of the candidate's path, i.e. f_k = sqrt(f(x)² + f(y)²) in terms of Eq. 18.
+:func:`residuals` spells each term out instant by instant (least squares): f_k = sqrt(Σ r²) over its residuals.
 """
 
 from __future__ import annotations
@@ -14,9 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mechopt.sim.flexible.response import normalised_error
+from mechopt.sim.flexible.response import normalised_error, normalised_residuals
 
-__all__ = ["PATHS", "TERMS", "FourBarResponse", "five_term_error", "path_error"]
+__all__ = ["PATHS", "TERMS", "FourBarResponse", "five_term_error", "path_error", "residuals"]
 
 #: The mid-point paths of Eq. 25, by the link they belong to.
 PATHS = ("crank", "coupler", "follower")
@@ -75,3 +76,20 @@ def five_term_error(r: FourBarResponse, target: FourBarResponse) -> dict[str, fl
     out["f_D4"] = normalised_error(r.D4, target.D4)
     out["f"] = float(sum(out[k] for k in TERMS))
     return out
+
+
+def residuals(r: FourBarResponse, target: FourBarResponse) -> np.ndarray:
+    """The residuals of Eq. 25, term after term in the order of :data:`TERMS`.
+
+    A path contributes its x then its y residuals, (x_i − x*_i) / (R_x sqrt(N)) (2N values), D3 and D4 N values
+    each (:func:`~mechopt.sim.flexible.response.normalised_residuals`): the square root of a term's sum of squares
+    is that term of :func:`five_term_error`, so f = 0 exactly where every residual is 0.
+
+    Returns
+    -------
+    ndarray (8 N,)
+        Dimensionless.
+    """
+    parts = [normalised_residuals(getattr(r, k)[:, j], getattr(target, k)[:, j]) for k in PATHS for j in (0, 1)]
+    parts += [normalised_residuals(r.D3, target.D3), normalised_residuals(r.D4, target.D4)]
+    return np.concatenate(parts)

@@ -44,6 +44,9 @@ class RowingProblem(DesignProblem):
     objective = "mse_N2"
     fit = "value"
     constraints = CONSTRAINTS
+    #: The mean square error is the sum of squares of (F_d − F) / √n: a least-squares problem.
+    residuals = "residuals"
+    version = 2
 
     def __init__(self, variables: tuple[Variable, ...], theta: np.ndarray, desired: np.ndarray, k: float = 244.0
                  ) -> None:
@@ -76,7 +79,8 @@ class RowingProblem(DesignProblem):
         err = self.desired - f
         mse = float(np.dot(err, err) / err.size)
         return {"mse_N2": mse, "rms_error_N": float(np.sqrt(mse)), "max_error_N": float(np.max(np.abs(err))),
-                "f_max_N": float(f.max()), "f_min_N": float(f.min())}
+                "f_max_N": float(f.max()), "f_min_N": float(f.min()),
+                "residuals": (err / np.sqrt(err.size)).tolist()}
 
     def figures(self, designs: Mapping[str, np.ndarray], out: Path) -> dict[str, Path]:
         from mechopt.sim.slider_crank.figures import cycle_animation, effort_figure, limit_positions_figure

@@ -72,7 +72,7 @@ def runs(tmp_path_factory):
     for budget in (60, 150):
         with capsys:
             code = main(["study", str(toml), "--out", str(folder / f"out{budget}"), "--workers", "2",
-                         "--no-progress", "--budget", str(budget)])
+                         "--no-progress", "--budget", str(budget), "--method", "sparse"])
         assert code == 0, capsys.text
         out[budget] = (capsys.text, json.loads((folder / f"out{budget}" / "result.json").read_text()),
                        folder / f"out{budget}" / "samples.sqlite")
@@ -99,15 +99,19 @@ class _Capture:
 def test_dry_run_prints_the_plan_and_simulates_nothing(tmp_path, capsys):
     toml = write_study(tmp_path)
     out = tmp_path / "out"
-    assert main(["study", str(toml), "--out", str(out), "--workers", "2", "--budget", "60", "--dry-run"]) == 0
+    assert main(["study", str(toml), "--out", str(out), "--workers", "2", "--budget", "60", "--method", "sparse",
+                 "--dry-run"]) == 0
     text = capsys.readouterr().out
     assert _calls(tmp_path) == 0 and not out.exists()  # no simulation, no store, no folder
     assert "study my-ext: A user's expensive simulator behind a command" in text and "ExternalProblem" not in text
     assert "x in [0, 1] mm" in text and "`{python} sim.py`" in text
     assert "global model: 3 lines: 12 simulations" in text and "confirm the model's candidate: 1 simulation" in text
-    assert "up to 47 simulations (one at a time)" in text and "validate: 2 held-out lines of 6: up to 12" in text
-    # 12 lines on 2 workers: 6 rounds; 1 + 47 one at a time; 12 held out: 6 rounds -> 60 x 85 s = 85 min.
-    assert "at most 72 designs, 72 to simulate; expected simulation time about 85 min" in text
+    assert "refine: model steps: up to 11 simulations (6 rounds of 2)" in text
+    assert "corrected steps: up to 36 simulations (18 rounds of 2)" in text
+    assert "validate: 2 held-out lines of 6: up to 12" in text
+    # 12 lines on 2 workers: 6 rounds; 1; the refinement's 47 in batches of 2 (issue 28): 6 + 18 rounds; 12 held
+    # out: 6 rounds -> 37 x 85 s = 52 min.
+    assert "at most 72 designs, 72 to simulate; expected simulation time about 52 min on 2 workers (37 rounds" in text
     assert "85 s a simulation, declared in [simulator] seconds_per_run" in text
 
 
@@ -127,6 +131,10 @@ def test_budget_60_costs_at_most_72_designs_and_says_so(runs):
     assert _stored(store) <= 72 and sims["distinct_designs"] <= 72
     assert "budget 60" in text and "on top of the budget: 20% of it" in text
     assert result["budget"] == 60 and result["plan"]["total"] == 72
+    # Issue 28: the rounds of simulations, the workers' idle share, waiting and the method's own time.
+    assert sims["rounds"] < sims["new"] and 0 <= sims["idle_share"] <= 1 and sims["workers"] == 2
+    assert sims["optimisation_timing"]["rounds"] <= sims["rounds"] and result["plan"]["rounds"] < 72
+    assert "rounds of simulations on 2 workers (idle" in text and "s of the method's own computing" in text
     report = (store.parent / "report.md").read_text()
     assert "on top of the budget, 20% of it" in report and ".." not in report.replace("../", "")
     # Errors against the range of the values, never a percentage of a best value near 0.
@@ -144,7 +152,7 @@ def test_the_plan_of_a_resumed_store_counts_what_it_holds(runs, capsys):
     folder, toml, out = runs
     before = _calls(folder)
     assert main(["study", str(toml), "--out", str(folder / "out60"), "--workers", "1", "--budget", "60",
-                 "--dry-run"]) == 0
+                 "--method", "sparse", "--dry-run"]) == 0
     text = capsys.readouterr().out
     assert _calls(folder) == before
     # Same seed, same plan: the 12 line designs are in the store, and the cost is the store's measured median.

@@ -75,8 +75,11 @@ def test_more_budget_is_never_worse_on_the_suite(name):
     assert answers[1] <= answers[0] + tol and answers[2] <= answers[1] + tol, answers
 
 
-def test_lines_lost_to_a_failing_simulator_are_one_clear_error():
+def test_lines_lost_to_a_failing_simulator_hand_the_budget_to_the_default_method():
+    # Failed simulations are a hidden constraint, not the end of a run (issue 22): the line model that cannot be
+    # built says why, and the rest of the budget goes to `auto`, which starts from every design already simulated.
     study = load_study("failing_hartmann3")
     options = study_options(study, {"budget": 60, "seed": 0, "validation_lines": 0})
-    with pytest.raises(mechopt.MechoptError, match=r"of the 3 lines of the global model failed to simulate"):
-        mechopt.minimize(study.problem, budget=60, seed=0, options=options, method="sparse")
+    result = mechopt.minimize(study.problem, budget=60, seed=0, options=options, method="sparse")
+    assert "of the 3 lines of the global model failed to simulate" in result.message
+    assert result.success and result.nfev <= 60 and result["nfailed"] > 0

@@ -102,3 +102,18 @@ def test_figures_are_written(six, tmp_path: Path):
     assert len(made) == 2
     for path in made.values():
         assert path.is_file() and path.stat().st_size > 10_000
+
+
+@pytest.mark.parametrize(("name", "budget", "f_max", "kappa_rtol"), [
+    ("flexible-four-bar", 400, 1e-6, 1e-2),      # measured f = 0 exactly, 11 s
+    ("flexible-four-bar-12", 1000, 1e-4, 2e-2),  # measured f = 9.9e-12, 24 s
+])
+def test_the_default_method_recovers_the_target(name, budget, f_max, kappa_rtol):
+    study = mechopt.load_study(name)
+    result = mechopt.minimize(study.problem, budget=budget, seed=0)
+    assert result.plan == "least-squares" and result.nfev <= budget
+    assert result.fun <= f_max
+    np.testing.assert_allclose(result.x[:4], [285.0, 100.0, 250.0, 250.0], rtol=1e-3)
+    target = study.problem.evaluate(study.design("reference"))
+    for k in ("kappa3", "kappa4"):
+        assert result.outputs[k] == pytest.approx(target[k], rel=kappa_rtol)

@@ -94,3 +94,21 @@ def test_figures(problem, tmp_path):
     assert len(figs) == 3
     for path in figs.values():
         assert path.is_file() and path.stat().st_size > 1000
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_default_method_takes_the_least_squares_plan_to_the_exact_optimum(problem, seed):
+    import mechopt
+
+    res = mechopt.minimize(problem, budget=30, method="auto", seed=seed)
+    assert res.plan == "least-squares" and res.nfev <= 30
+    # measured 3.7e-7 mm from the brute-force optimum (the compare section's value is rounded to 1e-6 mm)
+    np.testing.assert_allclose(res.x, [3.278676, 13.524580], atol=2e-6)
+    assert res.fun == pytest.approx(8.2187e-4, rel=1e-4)
+
+
+def test_residuals_are_the_mean_square_error_split(problem):
+    out = problem.evaluate(np.array([3.0, 14.0]))
+    r = problem.residual_vector(out)
+    assert r.size == problem.theta.size
+    assert float(r @ r) == pytest.approx(out["mse_N2"], rel=1e-12)

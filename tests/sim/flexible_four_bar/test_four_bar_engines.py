@@ -1,5 +1,6 @@
 """Exudyn's geometrically exact ANCF cables against the modal KED model (with its geometric terms) at the target and
-at 20 random crank-rockers of the paper's 12-variable box whose links stay below a tenth of their Euler load."""
+at 20 random crank-rockers of the paper's 12-variable box whose links stay below a quarter of their Euler load: the
+issue's 0.5 % (Eq. 18) on every response."""
 
 import numpy as np
 import pytest
@@ -9,10 +10,14 @@ from mechopt.sim.flexible_four_bar import FlexibleFourBar, simulate
 from mechopt.sim.flexible_four_bar.kinematics import crank_rocker_margins
 from mechopt.sim.flexible_four_bar.loads import euler_load_ratios
 from mechopt.sim.flexible_four_bar.problem import ALL_VARIABLES, PAPER_BOUNDS
+from mechopt.sim.flexible_four_bar.response import path_error
 
-#: Largest axial compression over the Euler load of the designs compared: beyond it the deflections reach ~1 % of
-#: the length and the linear model parts from the exact one (3-25 % of D's range at 0.2-0.4; README).
-LOAD_RATIO = 0.1
+#: Largest axial compression over the Euler load of the designs compared (20 of the first 40 crank-rockers drawn;
+#: of the other 20, those at 0.28, 0.29 and 0.44 agree to 0.55 %, 0.45 % and 0.42 %, the 17 at 0.47-254 part by
+#: 1.3-30 % or buckle; README).
+LOAD_RATIO = 0.25
+#: The issue's agreement: Eq. 18 between the engines at most 0.5 % on every response.
+AGREE = 5e-3
 
 
 def _designs(n: int, seed: int) -> list[FlexibleFourBar]:
@@ -36,30 +41,37 @@ def runs():
             for p in _designs(20, seed=1)]
 
 
-def test_paths_agree_to_a_thousandth_of_their_range(runs):
+def test_paths_agree_within_half_a_percent(runs):
     for ex, mo, _ in runs:
         for k in ("crank", "coupler", "follower"):
             a, b = getattr(ex, k), getattr(mo, k)
-            # measured worst 7.3e-4 of the range (follower y); the links' deflection is ~1e-2 of it
-            assert np.max(np.abs(a - b) / np.ptp(b, axis=0)) < 1e-3
+            assert path_error(b, a) < AGREE  # Eq. 25's path term: measured worst 4.8e-4 (follower, load ratio 0.20)
+            # worst single sample: measured 2.0e-3 of the range (follower, load ratio 0.24); the deflections are
+            # ~1e-2 of it
+            assert np.max(np.abs(a - b) / np.ptp(b, axis=0)) < 3e-3
 
 
-def test_deflections_agree_within_the_papers_error_measure(runs):
+def _rms(d: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(d**2)))
+
+
+def test_deflections_agree_within_half_a_percent(runs):
     worst, late = 0.0, 0.0
     for ex, mo, _ in runs:
         for k in ("D3", "D4"):
             a, b = getattr(ex, k), getattr(mo, k)
             worst = max(worst, normalised_error(a, b))  # Eq. 18 between the engines
-            late = max(late, float(np.max(np.abs(a - b)[60:]) / np.ptp(b)))  # second crank turn
-    # measured worst 6.0e-3 (Eq. 18) and 5.4e-3 (second turn); the first turn's start transient is where they part
-    # most (up to 4 % of the range at one sample): the links' elastic inertia changes their axial forces there
-    assert worst < 8e-3
-    assert late < 8e-3
+            late = max(late, _rms((a - b)[61:]) / np.ptp(a))  # the same over the second crank turn alone
+    # measured worst 3.2e-3 (D3, load ratio 0.24) and 3.8e-3 (second turn); at load ratios <= 0.1 1.5e-3 and
+    # 4e-4, most of it Exudyn's own time step (1.2e-3 from 32 steps a sample).  Before the modal engine's
+    # chord-shortening term and its consistent Δc0 the worst at <= 0.1 were 6.0e-3 (D4) and 2.0e-3, and 11 % at 0.28
+    assert worst < AGREE
+    assert late < AGREE
 
 
 def test_geometric_terms_are_what_separates_the_papers_model(runs):
     ex, mo, paper = runs[0]  # the target: axial forces 2-5 % of the Euler load
     for k in ("D3", "D4"):
         exact, linear = getattr(ex, k), getattr(paper, k)
-        assert normalised_error(linear, exact) > 5e-3  # measured 8.4e-3, 6.8e-3: 5-10x the engines' gap
-        assert normalised_error(getattr(mo, k), exact) < 2e-3  # measured 1.2e-3, 8.0e-4
+        assert normalised_error(linear, exact) > 5e-3  # measured 7.6e-3, 7.3e-3: 10x the engines' gap
+        assert normalised_error(getattr(mo, k), exact) < 1.5e-3  # measured 8.1e-4, 8.0e-4
