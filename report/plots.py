@@ -56,13 +56,29 @@ def _draw_marks(ax, problem: DesignProblem, marks: Mapping[str, np.ndarray], val
                     fontsize=8, bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8})
 
 
+def _constraint_plane(problem: DesignProblem, base: np.ndarray) -> tuple[int, int]:
+    """The two variables after the first whose change moves the constraint margins most at ``base`` (over their
+    range): above 3 variables the last two may not enter any constraint (a translation of a whole linkage)."""
+    d, b = problem.dim, problem.bounds
+    if not problem.constraints:
+        return d - 2, d - 1
+    h = 1e-4 * (b[:, 1] - b[:, 0])
+    X = np.vstack([base, base + np.diag(h)])
+    M = np.nan_to_num(problem.constraint_margins(X), nan=0.0, posinf=0.0, neginf=0.0)
+    effect = np.max(np.abs(M[1:] - M[0]), axis=1) / 1e-4
+    effect[0] = -1.0  # the slices' variable
+    first, second = sorted(int(i) for i in np.argsort(-effect)[:2])
+    return first, second
+
+
 def plot_feasible_slices(problem: DesignProblem, path: str | Path, marks: Mapping[str, np.ndarray] | None = None,
                          n_slices: int = 4, n: int = 240, model=None) -> Path:
     """The feasible region with each constraint's zero contour (paper Fig. 7, 12).
 
     For d = 2 one panel of the plane; for d >= 3 slices in the plane of the last two variables at fixed values of
-    the first (the others at the middle of their range), one slice at each marked design's own value, so that
-    every mark is drawn where it lies.
+    the first (the others at the optimum's values when a mark is named so, else at the middle of their range: in 8
+    variables the middle of the box is rarely feasible), one slice at each marked design's own value, so that every
+    mark is drawn where it lies.
 
     Parameters
     ----------
@@ -83,7 +99,9 @@ def plot_feasible_slices(problem: DesignProblem, path: str | Path, marks: Mappin
     marks = dict(marks or {})
     d = problem.dim
     b = problem.bounds
-    ix, iy = (0, 1) if d == 2 else (d - 2, d - 1)
+    optimum = next((np.asarray(x, dtype=float) for name, x in marks.items() if "optimum" in name), None)
+    base = optimum if optimum is not None and d > 3 else 0.5 * (b[:, 0] + b[:, 1])
+    ix, iy = (0, 1) if d == 2 else (d - 2, d - 1) if d == 3 else _constraint_plane(problem, base)
     gx, gy = np.linspace(*b[ix], n), np.linspace(*b[iy], n)
     GX, GY = np.meshgrid(gx, gy, indexing="ij")
     slices = [None] if d == 2 else _slice_values(problem, marks, n_slices)
@@ -92,7 +110,7 @@ def plot_feasible_slices(problem: DesignProblem, path: str | Path, marks: Mappin
     handles: dict[str, object] = {}
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for ax, value in zip(axes[0], slices, strict=True):
-        X = np.tile(0.5 * (b[:, 0] + b[:, 1]), (GX.size, 1))
+        X = np.tile(base, (GX.size, 1))
         if value is not None:
             X[:, 0] = value
         X[:, ix], X[:, iy] = GX.ravel(), GY.ravel()
