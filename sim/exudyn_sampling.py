@@ -1,5 +1,6 @@
-"""What every Exudyn engine of mechopt shares: the solver settings of a run sampled at fixed instants, and a
-sensor's stored values read back on those instants."""
+"""What every Exudyn engine of mechopt shares: the solver settings of a run sampled at fixed instants, a
+sensor's stored values read back on those instants, and the rigid crank turned at a constant rate that drives the
+flexible linkages."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import numpy as np
 
 from mechopt.errors import MechoptError
 
-__all__ = ["sampled", "solver_settings"]
+__all__ = ["add_driven_crank", "sampled", "solver_settings"]
 
 
 def solver_settings(exu, t_end: float, n_samples: int, steps_per_sample: int, newton_tolerance: float):
@@ -59,3 +60,33 @@ def sampled(mbs, sensor: int, t_end: float, n_samples: int,
     if stored < n_samples:
         raise error(f"Exudyn stored {stored} of {n_samples} samples")
     return values
+
+
+def add_driven_crank(mbs, items, length: float, omega: float, ground: int, m_ground_coord: int) -> int:
+    """A rigid crank pinned at the origin and turned at the constant rate ``omega``; returns the marker of its tip.
+
+    Parameters
+    ----------
+    mbs, items : Exudyn system and its ``itemInterface`` module.
+    length : float
+        Crank length (m).
+    omega : float
+        Prescribed rate (rad/s), counter-clockwise; the crank starts along +x.
+    ground : int
+        The ground body.
+    m_ground_coord : int
+        A ground coordinate marker (the rate constraint's reference).
+    """
+    # its inertia is irrelevant (the rate is prescribed), a small one keeps the mass matrix regular
+    crank_mass = 1e-3
+    n_crank = mbs.AddNode(items.NodeRigidBody2D(referenceCoordinates=[0.0, 0.0, 0.0],
+                                                initialVelocities=[0.0, 0.0, omega]))
+    o_crank = mbs.AddObject(items.ObjectRigidBody2D(mass=crank_mass, inertia=crank_mass * length * length / 3.0,
+                                                    nodeNumber=n_crank))
+    m_o_ground = mbs.AddMarker(items.MarkerBodyRigid(bodyNumber=ground, localPosition=[0.0, 0.0, 0.0]))
+    m_o_crank = mbs.AddMarker(items.MarkerBodyRigid(bodyNumber=o_crank, localPosition=[0.0, 0.0, 0.0]))
+    mbs.AddObject(items.RevoluteJoint2D(markerNumbers=[m_o_ground, m_o_crank]))
+    m_crank_angle = mbs.AddMarker(items.MarkerNodeCoordinate(nodeNumber=n_crank, coordinate=2))
+    mbs.AddObject(items.CoordinateConstraint(markerNumbers=[m_ground_coord, m_crank_angle], offset=omega,
+                                             velocityLevel=True))
+    return mbs.AddMarker(items.MarkerBodyRigid(bodyNumber=o_crank, localPosition=[length, 0.0, 0.0]))

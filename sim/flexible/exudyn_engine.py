@@ -20,7 +20,7 @@ import time
 import numpy as np
 
 from mechopt.errors import InputError
-from mechopt.sim.exudyn_sampling import sampled, solver_settings
+from mechopt.sim.exudyn_sampling import add_driven_crank, sampled, solver_settings
 from mechopt.sim.flexible.kinematics import rigid_motion
 from mechopt.sim.flexible.parameters import FlexibleSliderCrank
 from mechopt.sim.flexible.response import Response
@@ -79,7 +79,7 @@ def simulate_exudyn(p: FlexibleSliderCrank, steps_per_sample: int = 8, newton_to
     ground = mbs.AddObject(items.ObjectGround())
     n_ground = mbs.AddNode(items.NodePointGround())
     m_ground_coord = mbs.AddMarker(items.MarkerNodeCoordinate(nodeNumber=n_ground, coordinate=0))
-    m_crank_tip = _add_crank(mbs, items, p, ground, m_ground_coord)
+    m_crank_tip = add_driven_crank(mbs, items, p.l2, p.omega, ground, m_ground_coord)
     s_nodes = np.linspace(0.0, p.l3, p.n_elements + 1)
     nodes, u_end = _add_rod(mbs, items, p, s_nodes, m_crank_tip)
     n_slider = _add_slider(mbs, items, p, nodes[-1], u_end, m_ground_coord)
@@ -87,24 +87,6 @@ def simulate_exudyn(p: FlexibleSliderCrank, steps_per_sample: int = 8, newton_to
     mbs.Assemble()
     mbs.SolveDynamic(solver_settings(exu, p.t_end, p.n_samples, steps_per_sample, newton_tolerance))
     return _response(mbs, p, sensors, s_nodes, start)
-
-
-def _add_crank(mbs, items, p: FlexibleSliderCrank, ground: int, m_ground_coord: int) -> int:
-    """The crank pinned at O and turned at the constant rate ω; returns the marker of its tip A."""
-    r, w = p.l2, p.omega
-    # its inertia is irrelevant (the rate is prescribed), a small one keeps the mass matrix regular
-    crank_mass = 1e-3
-    n_crank = mbs.AddNode(items.NodeRigidBody2D(referenceCoordinates=[0.0, 0.0, 0.0],
-                                                initialVelocities=[0.0, 0.0, w]))
-    o_crank = mbs.AddObject(items.ObjectRigidBody2D(mass=crank_mass, inertia=crank_mass * r * r / 3.0,
-                                                    nodeNumber=n_crank))
-    m_o_ground = mbs.AddMarker(items.MarkerBodyRigid(bodyNumber=ground, localPosition=[0.0, 0.0, 0.0]))
-    m_o_crank = mbs.AddMarker(items.MarkerBodyRigid(bodyNumber=o_crank, localPosition=[0.0, 0.0, 0.0]))
-    mbs.AddObject(items.RevoluteJoint2D(markerNumbers=[m_o_ground, m_o_crank]))
-    m_crank_angle = mbs.AddMarker(items.MarkerNodeCoordinate(nodeNumber=n_crank, coordinate=2))
-    mbs.AddObject(items.CoordinateConstraint(markerNumbers=[m_ground_coord, m_crank_angle], offset=w,
-                                             velocityLevel=True))
-    return mbs.AddMarker(items.MarkerBodyRigid(bodyNumber=o_crank, localPosition=[r, 0.0, 0.0]))
 
 
 def _add_rod(mbs, items, p: FlexibleSliderCrank, s_nodes: np.ndarray, m_crank_tip: int) -> tuple[list[int], float]:

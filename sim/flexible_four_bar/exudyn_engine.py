@@ -25,7 +25,7 @@ import time
 import numpy as np
 
 from mechopt.errors import InputError, MechoptError
-from mechopt.sim.exudyn_sampling import sampled, solver_settings
+from mechopt.sim.exudyn_sampling import add_driven_crank, sampled, solver_settings
 from mechopt.sim.flexible_four_bar.kinematics import require_crank_rocker, rigid_motion
 from mechopt.sim.flexible_four_bar.parameters import FlexibleFourBar, FlexibleLink
 from mechopt.sim.flexible_four_bar.response import FourBarResponse
@@ -72,7 +72,7 @@ def simulate_exudyn(p: FlexibleFourBar, steps_per_sample: int = 8, newton_tolera
     ground = mbs.AddObject(items.ObjectGround())
     n_ground = mbs.AddNode(items.NodePointGround())
     m_ground_coord = mbs.AddMarker(items.MarkerNodeCoordinate(nodeNumber=n_ground, coordinate=0))
-    m_crank_tip = _add_crank(mbs, items, p, ground, m_ground_coord)
+    m_crank_tip = add_driven_crank(mbs, items, p.l2, p.omega, ground, m_ground_coord)
     th3, w3, th4, w4 = (float(v[0]) for v in (rig0.theta3, rig0.omega3, rig0.theta4, rig0.omega4))
     coupler = _add_link(mbs, items, p.coupler, p.l3, p.n_elements, p.beta, origin=(p.l2, 0.0),
                         v_origin=(0.0, p.l2 * p.omega), theta=th3, rate=w3)
@@ -96,24 +96,6 @@ def simulate_exudyn(p: FlexibleFourBar, steps_per_sample: int = 8, newton_tolera
     P4 = np.stack([sampled(mbs, k, p.t_end, p.n_samples)[:, :2] for k in sensors[1]], axis=1)
     _check_closure(p, P3, P4)
     return _response(p, P3, P4, start)
-
-
-def _add_crank(mbs, items, p: FlexibleFourBar, ground: int, m_ground_coord: int) -> int:
-    """The crank pinned at O2 and turned at the constant rate ω; returns the marker of its tip B."""
-    r, w = p.l2, p.omega
-    # its inertia is irrelevant (the rate is prescribed), a small one keeps the mass matrix regular
-    crank_mass = 1e-3
-    n_crank = mbs.AddNode(items.NodeRigidBody2D(referenceCoordinates=[0.0, 0.0, 0.0],
-                                                initialVelocities=[0.0, 0.0, w]))
-    o_crank = mbs.AddObject(items.ObjectRigidBody2D(mass=crank_mass, inertia=crank_mass * r * r / 3.0,
-                                                    nodeNumber=n_crank))
-    m_o_ground = mbs.AddMarker(items.MarkerBodyRigid(bodyNumber=ground, localPosition=[0.0, 0.0, 0.0]))
-    m_o_crank = mbs.AddMarker(items.MarkerBodyRigid(bodyNumber=o_crank, localPosition=[0.0, 0.0, 0.0]))
-    mbs.AddObject(items.RevoluteJoint2D(markerNumbers=[m_o_ground, m_o_crank]))
-    m_crank_angle = mbs.AddMarker(items.MarkerNodeCoordinate(nodeNumber=n_crank, coordinate=2))
-    mbs.AddObject(items.CoordinateConstraint(markerNumbers=[m_ground_coord, m_crank_angle], offset=w,
-                                             velocityLevel=True))
-    return mbs.AddMarker(items.MarkerBodyRigid(bodyNumber=o_crank, localPosition=[r, 0.0, 0.0]))
 
 
 def _add_link(mbs, items, link: FlexibleLink, length: float, n: int, beta: float, origin: tuple[float, float],
