@@ -137,8 +137,8 @@ class StoreConnection:
                 # In WAL mode NORMAL loses no committed transaction when the *process* dies (only on power loss),
                 # and avoids an fsync per result.
                 conn.execute("PRAGMA synchronous = NORMAL")
-                if holds_current_schema(self.conn, self.path):
-                    return
+                # One transaction for the check and the creation: outside it, the version and the table list are two
+                # reads, and another process's creation can land between them (version 0 with every table).
                 with self.transaction():
                     if holds_current_schema(self.conn, self.path):
                         return
