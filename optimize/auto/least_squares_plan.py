@@ -20,8 +20,8 @@ __all__ = ["least_squares_plan"]
 
 #: Starts tried per round before the sample grows again.
 STARTS_PER_ROUND = 3
-#: An exploring run stops when a Jacobian's worth of steps gained less than this share of its sum of squares: the
-#: rest of a slow, linear convergence is spent only on the best design (the final polish).
+#: An exploring run stops when a Jacobian's worth of simulations (d + 1) gained less than this share of its sum of
+#: squares: the rest of a slow, linear convergence is spent only on the best design (the final polish).
 STALL = 0.01
 
 
@@ -67,6 +67,8 @@ def least_squares_plan(run: _ResidualRun, batch: int, step: float,
         if best is not None and run.remaining <= reserve and best not in polished:
             polished.add(best)
             lines.append(state.local(best, run.remaining, 0.0, batch, step, margins))
+            # The polish's own end is polished: only a better basin found by exploration earns another.
+            polished.add(_best(run))
             continue
         for i in state.starts():
             if run.remaining <= (reserve if best not in polished else 0):

@@ -112,8 +112,9 @@ def gauss_newton(evaluate: ResidualEvaluator, u0: np.ndarray, r0: np.ndarray, va
     radius : float
         Initial trust-region half-edge (unit cube).
     stall : float
-        Stop when the sum of squares fell by less than this fraction between two fresh Jacobians (0: run to
-        convergence).  A multistart explores with a loose value and polishes its best design with 0.
+        Stop when the sum of squares fell by less than this fraction between two fresh Jacobians, or over d + 1
+        simulations of steps since the last check (0: run to convergence).  A multistart explores with a loose value
+        and polishes its best design with 0.
 
     Returns
     -------
@@ -121,23 +122,30 @@ def gauss_newton(evaluate: ResidualEvaluator, u0: np.ndarray, r0: np.ndarray, va
     """
     s = _State(np.asarray(u0, dtype=float), np.asarray(r0, dtype=float), float(value0))
     run = LocalRun(s.u.copy(), s.value, s.merit, visited=[s.u.copy()])
-    last_fresh = np.inf
+    # The stall test compares the sum of squares at each fresh Jacobian with the one before, and also after every
+    # d + 1 simulations of steps on updated Jacobians: a run creeping along a valley by Broyden steps spends as
+    # much as one differencing afresh, and must show as much progress.
+    mark, steps = np.inf, 0
     while True:
         why = _stop_reason(run, s, radius, budget)
         if why:
             run.message = why
             return run
-        if s.J is None or s.stale:
-            if last_fresh - s.merit < stall * last_fresh:
-                run.message = f"stalled: less than {stall:g} of the sum of squares gained since the last Jacobian"
+        fresh_needed = s.J is None or s.stale
+        if stall > 0.0 and (fresh_needed or steps >= s.u.size + 1):
+            if mark - s.merit < stall * mark:
+                run.message = f"stalled: less than {stall:g} of the sum of squares gained since the last check"
                 return run
-            last_fresh = s.merit
+            mark, steps = s.merit, 0
+        if fresh_needed:
             J = _jacobian(evaluate, s, step, allowed, run, budget)
             if J is None:
                 run.message = "the budget ran out, or every difference of the Jacobian failed"
                 return run
             s.J, s.fresh, s.stale = J, True, False
+        n0 = run.nfev
         radius = _iterate(evaluate, s, radius, batch, margins, run, budget, allowed)
+        steps += run.nfev - n0
 
 
 def _stop_reason(run: LocalRun, s: _State, radius: float, budget: int) -> str:

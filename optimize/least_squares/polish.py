@@ -28,10 +28,15 @@ class _Counted:
         return tuple(np.round(self.lo + np.clip(u, 0.0, 1.0) * self.width, KEY_DECIMALS).tolist())
 
     def __call__(self, U: np.ndarray) -> tuple[np.ndarray, list]:
-        keys = [self.key(u) for u in np.atleast_2d(U)]
-        new = list(dict.fromkeys(k for k in keys if k not in self.seen))[: self.budget - len(self.seen)]
+        U = np.atleast_2d(U)
+        keys = [self.key(u) for u in U]
+        # The designs themselves are simulated, not their rounded keys: a design on an active constraint rounded
+        # to the store's resolution can fall outside it.
+        first = {k: self.lo + np.clip(u, 0.0, 1.0) * self.width for k, u in zip(keys, U, strict=True)
+                 if k not in self.seen}
+        new = list(first)[: self.budget - len(self.seen)]
         if new:
-            values, R = self.residuals(np.array(new, dtype=float))
+            values, R = self.residuals(np.array([first[k] for k in new], dtype=float))
             for k, v, r in zip(new, values, R, strict=True):
                 self.seen[k] = (float(v), None if r is None else np.asarray(r, dtype=float))
         n = next((i for i, k in enumerate(keys) if k not in self.seen), len(keys))
