@@ -67,6 +67,22 @@ class GaussianProcess:
         var = np.maximum(self.signal - np.sum(V * V, axis=0), 1e-12 * self.signal)
         return mean, np.sqrt(var)
 
+    def draw(self, U: np.ndarray, n: int, rng: np.random.Generator) -> np.ndarray:
+        """``n`` joint draws (n, m) of the latent function at designs U (m, d) from the posterior."""
+        U = np.atleast_2d(U)
+        Ks, _ = _matern(U, self.X, self.ell, self.signal)
+        Kss, _ = _matern(U, U, self.ell, self.signal)
+        V = solve_triangular(self.L, Ks.T, lower=True)
+        C = Kss - V.T @ V
+        try:
+            # The jitter keeps near-duplicate candidates from making the factor fail; 1e-6 of the signal is below
+            # anything the draws' argmin can resolve.
+            F = np.linalg.cholesky(C + 1e-6 * self.signal * np.eye(U.shape[0]))
+        except np.linalg.LinAlgError:
+            w, Q = np.linalg.eigh(C)
+            F = Q * np.sqrt(np.maximum(w, 0.0))
+        return Ks @ self.alpha + (F @ rng.standard_normal((U.shape[0], n))).T
+
     def believe(self, U: np.ndarray) -> GaussianProcess:
         """The same GP with designs U (m, d) added at their posterior mean (the kriging believer of a batch)."""
         U = np.atleast_2d(U)

@@ -6,7 +6,8 @@
 * ``trust-region`` (d >= 5): expected-improvement steps in a trust region around the incumbent, which grows and
   shrinks with success and restarts at the global model's most promising point when it collapses (TuRBO, Eriksson
   et al. 2019); the last tenth of the budget minimises the local model's mean around the best design of any
-  restart (a final polish).
+  restart (a final polish).  A batch of several designs a step is the minimisers of as many posterior draws
+  (Thompson sampling, TuRBO's choice): the kriging believer spreads a batch to the region's corners.
 
 * ``least-squares`` (any d, when the problem declares residuals): Gauss-Newton runs on the residuals from the
   starts that multi-level single linkage picks in a growing Sobol sample (:mod:`mechopt.optimize.least_squares`).
@@ -57,8 +58,12 @@ class Plan:
         if self.name == "least-squares":
             what = "Gauss-Newton runs on the residuals from multi-level single linkage starts"
         else:
-            what = ("one global GP, expected improvement" if self.name == "global"
-                    else "expected improvement in a restarted trust region")
+            if self.name == "global":
+                what = "one global GP, expected improvement"
+            elif self.batch > 1:
+                what = f"Thompson-sampled batches of {self.batch} in a restarted trust region"
+            else:
+                what = "expected improvement in a restarted trust region"
             what += f", local polish of the last {self.n_polish}"
         return f"plan {self.name} (d = {dim}, budget {budget}): {self.n_init} Sobol designs, then {what}"
 

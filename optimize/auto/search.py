@@ -15,7 +15,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 from scipy.stats import qmc
 
-from mechopt.optimize.auto.acquisition import propose_batch
+from mechopt.optimize.auto.acquisition import propose_batch, thompson_batch
 from mechopt.optimize.auto.feasibility import SuccessModel
 from mechopt.optimize.auto.gp import GaussianProcess, fit_gp
 from mechopt.optimize.auto.least_squares_plan import least_squares_plan
@@ -297,8 +297,11 @@ def _trust_region_plan(run: _Run, plan: Plan) -> None:
             gp, best = run.fit(_local_indices(run, run.U[centre_i]))
             lo, hi = TrustRegion(d, length=min(tr.length, POLISH_LENGTH)).box(run.U[centre_i], gp.theta[:d])
             kappa = 0.0
-        U = propose_batch(gp, best, lo, hi, run.U[centre_i], k, run.rng, run.allowed, run.success_model(gp),
-                          kappa=kappa)
+        if k > 1 and kappa is None:
+            U = thompson_batch(gp, lo, hi, run.U[centre_i], k, run.rng, run.allowed, run.success_model(gp))
+        else:
+            U = propose_batch(gp, best, lo, hi, run.U[centre_i], k, run.rng, run.allowed, run.success_model(gp),
+                              kappa=kappa)
         before, n0 = vals.min(), run.values.size
         run.simulate(run.fill(U, k))
         members += list(range(n0, run.values.size))
