@@ -96,6 +96,13 @@ class _Run:
         self.n_full_fit = 0
 
     @property
+    def unit_margins(self) -> Callable[[np.ndarray], np.ndarray] | None:
+        """``margins(U) -> (m, c)`` of the declared constraints at designs U of the unit cube; None without any."""
+        if self.margins is None:
+            return None
+        return lambda U: self.margins(self.to_x(U))
+
+    @property
     def remaining(self) -> int:
         return self.budget - self.values.size
 
@@ -224,7 +231,7 @@ def _global_plan(run: _Run, plan: Plan) -> None:
             lo, hi = TrustRegion(d, length=POLISH_LENGTH).box(centre, gp.theta[:d])
             kappa = POLISH_KAPPA
             if run.margins is not None:
-                x = polish_on_constraints(gp, centre, lo, hi, lambda U: run.margins(run.to_x(U)), run.allowed)
+                x = polish_on_constraints(gp, centre, lo, hi, run.unit_margins, run.allowed)
                 first = first if x is None else x[None, :]
             if not probed and first.shape[0] < k:
                 probed = True
@@ -233,7 +240,7 @@ def _global_plan(run: _Run, plan: Plan) -> None:
         if first.shape[0] < k:
             U = propose_batch(gp, best, lo, hi, centre, k - first.shape[0], run.rng,
                               lambda C, taken=first: run.allowed(C) & _apart(C, taken), run.success_model(gp),
-                              kappa=kappa)
+                              kappa=kappa, margins=run.unit_margins)
             first = np.vstack([first, U])
         run.simulate(run.fill(first, k))
 
@@ -276,7 +283,7 @@ def _restart_centre(run: _Run) -> np.ndarray:
     gp, best = run.fit(_local_indices(run, run.U[run.best_index()]) if run.ok.sum() > 2 * LOCAL_POINTS else None)
     run.theta = saved
     U = propose_batch(gp, best, np.zeros(d), np.ones(d), run.U[run.best_index()], 1, run.rng, run.allowed,
-                      run.success_model(gp))
+                      run.success_model(gp), margins=run.unit_margins)
     return run.fill(U, 1)
 
 
@@ -301,7 +308,7 @@ def _trust_region_plan(run: _Run, plan: Plan) -> None:
             U = thompson_batch(gp, lo, hi, run.U[centre_i], k, run.rng, run.allowed, run.success_model(gp))
         else:
             U = propose_batch(gp, best, lo, hi, run.U[centre_i], k, run.rng, run.allowed, run.success_model(gp),
-                              kappa=kappa)
+                              kappa=kappa, margins=run.unit_margins)
         before, n0 = vals.min(), run.values.size
         run.simulate(run.fill(U, k))
         members += list(range(n0, run.values.size))
@@ -377,8 +384,7 @@ def auto_search(evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, seed:
         if run.ok.sum() < 2 and plan.name != "least-squares":
             run.simulate(_initial_design(run, run.remaining))
         if plan.name == "least-squares":
-            unit_margins = None if margins is None else (lambda U: margins(run.to_x(U)))
-            least_squares_plan(run, plan.batch, fd_step, unit_margins)
+            least_squares_plan(run, plan.batch, fd_step, run.unit_margins)
         else:
             (_global_plan if plan.name == "global" else _trust_region_plan)(run, plan)
     nfailed = int((~run.ok).sum())
