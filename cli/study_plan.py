@@ -243,13 +243,13 @@ def plan_run(study: Study, options: SparseOptions, method: str, store: SampleSto
 
 def _refinement(left: int, workers: int, dim: int) -> list[PlanStage]:
     """The sparse method's refinement: one stage one at a time; with batches, the model steps in rounds of
-    ``workers`` (their share of what is left, :data:`~mechopt.optimize.sparse.pipeline.BATCH_MODEL_STEP_SHARE`)
-    and the local search's designs with their gradients, d + 1 a round (issue 28)."""
-    from mechopt.optimize.sparse.pipeline import BATCH_MODEL_STEP_SHARE
+    ``workers`` (whole rounds of their share of what is left, as the pipeline takes them) and the local search's
+    designs with their gradients, d + 1 a round (issue 28)."""
+    from mechopt.optimize.sparse.pipeline import model_step_budget
 
     if workers <= 1:
         return [PlanStage("refine on the simulator (model steps, SLSQP, corrected steps)", left, exact=False)]
-    steps = min(left, max(workers, int(BATCH_MODEL_STEP_SHARE * left)))
+    steps = model_step_budget(left, workers)
     stages = [PlanStage("refine: model steps", steps, exact=False)]
     if left > steps:
         stages.append(PlanStage("refine: local search (each design with its gradient) and corrected steps",

@@ -12,6 +12,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -23,7 +24,7 @@ from mechopt.optimize.sparse.sampler import Sampler
 from mechopt.optimize.sparse.space import ModelSpace
 from mechopt.optimize.sparse.stage import Stage, build_stage
 
-__all__ = ["MISTRUST", "PipelineResult", "run_pipeline"]
+__all__ = ["MISTRUST", "PipelineResult", "model_step_budget", "run_pipeline"]
 
 #: Relative disagreement between model and simulation at the model's candidate beyond which the model is not trusted
 #: to have found the right basin (the ventilator's global model: 0.3 %; a false minimum of an overshooting blend on
@@ -99,7 +100,7 @@ def run_pipeline(space: ModelSpace, options: SparseOptions, sampler: Sampler,
             "the local search starts there")
     if options.refine and remaining > 0 and np.isfinite(start_value):
         # First the model steers (one simulation per step), then finite differences finish from where it stalled.
-        stepped = model_steps(space, sampler, stage, _model_step_budget(remaining, sampler.batch_size), options.seed)
+        stepped = model_steps(space, sampler, stage, model_step_budget(remaining, sampler.batch_size), options.seed)
         remaining -= stepped.n_samples
         stages.append(stepped)
         log(f"  model steps: {stepped.n_samples} simulations of trust-region steps on the corrected model; "
@@ -131,12 +132,14 @@ def run_pipeline(space: ModelSpace, options: SparseOptions, sampler: Sampler,
     return PipelineResult(stages=stages, best=best, n_simulations=len(sampler.designs) - used_before, message=message)
 
 
-def _model_step_budget(remaining: int, batch: int) -> int:
+def model_step_budget(remaining: int, batch: int) -> int:
     """The model steps' share of what is left: all of it one at a time (they stop by themselves once their region
     has shrunk, after 8 to 17 simulations at a budget of 60); with batches, :data:`BATCH_MODEL_STEP_SHARE` of it
     and at least one round, since a round of steps at several radii nearly always improves and they would not
-    stop (issue 28)."""
-    return remaining if batch <= 1 else min(remaining, max(batch, int(BATCH_MODEL_STEP_SHARE * remaining)))
+    stop (issue 28).  Whole rounds: a round of fewer than ``batch`` designs takes as long as a full one."""
+    if batch <= 1:
+        return remaining
+    return min(remaining, batch * max(1, math.ceil(BATCH_MODEL_STEP_SHARE * remaining / batch)))
 
 
 def _claim_text(stage: Stage, problem) -> str:

@@ -106,8 +106,8 @@ def test_dry_run_prints_the_plan_and_simulates_nothing(tmp_path, capsys):
     assert "study my-ext: A user's expensive simulator behind a command" in text and "ExternalProblem" not in text
     assert "x in [0, 1] mm" in text and "`{python} sim.py`" in text
     assert "global model: 3 lines: 12 simulations" in text and "confirm the model's candidate: 1 simulation" in text
-    assert "refine: model steps: up to 11 simulations (6 rounds of 2)" in text
-    assert "corrected steps: up to 36 simulations (18 rounds of 2)" in text
+    assert "refine: model steps: up to 12 simulations (6 rounds of 2)" in text
+    assert "corrected steps: up to 35 simulations (18 rounds of 2)" in text
     assert "validate: 2 held-out lines of 6: up to 12" in text
     # 12 lines on 2 workers: 6 rounds; 1; the refinement's 47 in batches of 2 (issue 28): 6 + 18 rounds; 12 held
     # out: 6 rounds -> 37 x 85 s = 52 min.
