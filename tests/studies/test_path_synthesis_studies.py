@@ -88,10 +88,10 @@ def test_paper000_hybrid_runs_within_a_small_budget_on_example_1():
                          [("path-synthesis-1", 0, 0.0073, 0.0061266), ("path-synthesis-2", 1, 0.103, 0.088407)])
 def test_default_method_beats_the_paper_with_2000_simulations(name, seed, paper_E, measured):
     """Gauss-Newton runs from multi-level single linkage starts (the default method's least-squares plan) reach a
-    feasible design below the paper's E with a tenth of the study's budget (seeds 0-4 at 2,000: example 1 below
-    0.0073 in 3 of 5, example 2 below 0.103 in 3 of 5; the seeds here are among them).  ``measured`` is the value
-    with numpy 2.4.6 and scipy 1.17.1: 2,000 simulations of many local runs amplify the last bits of another
-    numpy's or scipy's arithmetic (an earlier install gave 0.0061506 for example 1), so it is held to 5 %."""
+    feasible design below the paper's E with a tenth of the study's budget (seeds 0-4 at 2,000, numpy 2.4.6 and scipy
+    1.17.1: example 1 below 0.0073 in 1 of 5, example 2 below 0.103 in 2 of 5; the seeds here are among them).
+    ``measured`` is the value with those versions: 2,000 simulations of many local runs amplify the last bits of
+    another numpy's or scipy's arithmetic (an earlier install gave 0.0061506 for example 1), so it is held to 5 %."""
     import mechopt
 
     problem = load_study(name).problem
