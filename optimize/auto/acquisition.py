@@ -41,15 +41,26 @@ def log_expected_improvement(gp: GaussianProcess, U: np.ndarray, best: float) ->
     return log_h + np.log(sd)
 
 
-def _candidates(lo: np.ndarray, hi: np.ndarray, centre: np.ndarray, n: int, rng: np.random.Generator) -> np.ndarray:
-    """Sobol points of the box, and as many that move only a few coordinates of the centre (TuRBO's perturbation:
-    in many dimensions a point that changes every coordinate is almost never better)."""
+def _candidates(lo: np.ndarray, hi: np.ndarray, centre: np.ndarray, n: int, rng: np.random.Generator,
+                sparse: bool = False) -> np.ndarray:
+    """Sobol points of the box, and as many that move only some coordinates of the centre (TuRBO's perturbation:
+    in many dimensions a point that changes every coordinate is almost never better).
+
+    TuRBO changes each coordinate with probability min(1, 20/d): below 20 variables it changes them all, and the
+    perturbed points repeat the Sobol points.  With ``sparse`` the number of coordinates changed is uniform in
+    1..min(d, 20), so that a move of one or two variables with the rest kept (another well of one variable, where a
+    multimodal landscape has one a variable) is among the candidates too.
+    """
     d = lo.size
     sobol = qmc.Sobol(d, seed=rng).random_base2(max(1, round(math.log2(n))))
     n = sobol.shape[0]
     box = lo + sobol * (hi - lo)
-    mask = rng.random((n, d)) < min(1.0, 20.0 / d)
-    mask[np.arange(n), rng.integers(0, d, n)] = True
+    if sparse:
+        changed = rng.integers(1, min(d, 20) + 1, n)
+        mask = np.argsort(rng.random((n, d)), axis=1) < changed[:, None]
+    else:
+        mask = rng.random((n, d)) < min(1.0, 20.0 / d)
+        mask[np.arange(n), rng.integers(0, d, n)] = True
     local = np.where(mask, box, centre)
     return np.vstack([box, local])
 
@@ -105,7 +116,7 @@ def propose_batch(gp: GaussianProcess, best: float, lo: np.ndarray, hi: np.ndarr
                   rng: np.random.Generator, allowed: Callable[[np.ndarray], np.ndarray],
                   log_feasible: LogFeasible | None = None, n_candidates: int = 1024,
                   polish: int = 3, kappa: float | None = None,
-                  margins: Callable[[np.ndarray], np.ndarray] | None = None) -> np.ndarray:
+                  margins: Callable[[np.ndarray], np.ndarray] | None = None, sparse: bool = False) -> np.ndarray:
     """``q`` designs of the box [lo, hi] (unit cube) maximising log EI + log P(success), one after the other, each
     chosen with the previous ones believed at their posterior mean (Ginsbourger et al. 2010).
 
@@ -133,6 +144,9 @@ def propose_batch(gp: GaussianProcess, best: float, lo: np.ndarray, hi: np.ndarr
     margins : callable, optional
         ``margins(U) -> (m, c)``: declared constraints' margins (>= 0 feasible) at designs U of the unit cube; the
         polish of each choice then respects them and may end on one.
+    sparse : bool
+        Offer perturbations of the centre in any number of its coordinates (:func:`_candidates`); the trust-region
+        plan's choice, in 5 variables and more, where Sobol points of the box are too sparse to hold such moves.
 
     Returns
     -------
@@ -156,7 +170,7 @@ def propose_batch(gp: GaussianProcess, best: float, lo: np.ndarray, hi: np.ndarr
                 ok &= np.max(np.abs(U - x), axis=1) > 1e-6
             return ok
 
-        x = _maximise(score, lo, hi, _candidates(lo, hi, centre, n_candidates, rng), fresh, polish, margins)
+        x = _maximise(score, lo, hi, _candidates(lo, hi, centre, n_candidates, rng, sparse), fresh, polish, margins)
         if x is None:
             break
         chosen.append(x)
@@ -192,14 +206,16 @@ def thompson_batch(gp: GaussianProcess, lo: np.ndarray, hi: np.ndarray, centre: 
     log_feasible : callable, optional
         Log-probability that a design's simulation succeeds; candidates below 1/2 are dropped while any is above.
     n_candidates : int
-        Sobol candidates of the box (as many again perturb the centre).
+        Sobol candidates of the box (the centre's perturbations, which repeat them below 20 variables, dropped).
 
     Returns
     -------
     (k, d) ndarray
         k <= q distinct designs (fewer only when fewer allowed candidates are left).
     """
-    # Below 20 variables the centre's perturbations change every coordinate: they repeat the Sobol points.
+    # Below 20 variables the centre's perturbations repeat the Sobol points.  Perturbations in a few coordinates
+    # (``sparse``) were measured here too: independent draws then pile onto the centre's lines, and batches of 8 on
+    # Hartmann-6 at 60 simulations ended at 11.6 % of the range instead of 4.8 % (median of 5 seeds).
     C = np.unique(_candidates(lo, hi, centre, n_candidates, rng), axis=0)
     C = C[allowed(C)]
     if log_feasible is not None and C.shape[0]:

@@ -283,7 +283,7 @@ def _restart_centre(run: _Run) -> np.ndarray:
     gp, best = run.fit(_local_indices(run, run.U[run.best_index()]) if run.ok.sum() > 2 * LOCAL_POINTS else None)
     run.theta = saved
     U = propose_batch(gp, best, np.zeros(d), np.ones(d), run.U[run.best_index()], 1, run.rng, run.allowed,
-                      run.success_model(gp), margins=run.unit_margins)
+                      run.success_model(gp), margins=run.unit_margins, sparse=True)
     return run.fill(U, 1)
 
 
@@ -308,7 +308,7 @@ def _trust_region_plan(run: _Run, plan: Plan) -> None:
             U = thompson_batch(gp, lo, hi, run.U[centre_i], k, run.rng, run.allowed, run.success_model(gp))
         else:
             U = propose_batch(gp, best, lo, hi, run.U[centre_i], k, run.rng, run.allowed, run.success_model(gp),
-                              kappa=kappa, margins=run.unit_margins)
+                              kappa=kappa, margins=run.unit_margins, sparse=True)
         before, n0 = vals.min(), run.values.size
         run.simulate(run.fill(U, k))
         members += list(range(n0, run.values.size))

@@ -103,6 +103,18 @@ def test_steps_walk_onto_an_active_constraint():
         assert np.sum(np.abs(margins(r.X)[:, 0]) < 1e-5) >= 5
 
 
+def test_sparse_candidates_move_any_number_of_the_centres_coordinates():
+    from mechopt.optimize.auto.acquisition import _candidates
+
+    rng = np.random.default_rng(0)
+    lo, hi, centre = np.zeros(8), np.ones(8), np.full(8, 0.5)
+    moved = np.sum(_candidates(lo, hi, centre, 1024, rng)[1024:] != centre, axis=1)
+    assert moved.min() == 8  # TuRBO's rule below 20 variables: every coordinate, the Sobol points again
+    moved = np.sum(_candidates(lo, hi, centre, 1024, rng, sparse=True)[1024:] != centre, axis=1)
+    counts = np.bincount(moved, minlength=9)[1:]
+    assert counts.sum() == 1024 and counts.min() > 80  # 1 to 8 coordinates, each about 128 times
+
+
 def test_joint_posterior_draws_have_the_posterior_mean_and_covariance():
     rng = np.random.default_rng(3)
     X = rng.random((8, 2))
