@@ -96,16 +96,15 @@ def _maximise(score: Callable[[np.ndarray], np.ndarray], lo: np.ndarray, hi: np.
     s = score(C)
     order = np.argsort(-s)
     best_x, best_s = C[order[0]], s[order[0]]
-    fun = _with_gradient(score, lo, hi)
+    fun, bounds = _with_gradient(score, lo, hi), list(zip(lo, hi, strict=True))
+    if margins is None:
+        method, extra = "L-BFGS-B", {"options": {"maxiter": 30}}
+    else:
+        # A margin a hair above zero: SLSQP stops within its tolerance of the constraint, on either side.
+        method, extra = "SLSQP", {"options": {"maxiter": 50}, "constraints": [
+            {"type": "ineq", "fun": lambda u: margins(u[None, :])[0] - _MARGIN_EPS}]}
     for x0 in C[order[:polish]]:
-        if margins is None:
-            res = minimize(fun, x0, jac=True, method="L-BFGS-B", bounds=list(zip(lo, hi, strict=True)),
-                           options={"maxiter": 30})
-        else:
-            # A margin a hair above zero: SLSQP stops within its tolerance of the constraint, on either side.
-            res = minimize(fun, x0, jac=True, method="SLSQP", bounds=list(zip(lo, hi, strict=True)),
-                           constraints=[{"type": "ineq", "fun": lambda u: margins(u[None, :])[0] - _MARGIN_EPS}],
-                           options={"maxiter": 50})
+        res = minimize(fun, x0, jac=True, method=method, bounds=bounds, **extra)
         x = np.clip(res.x, lo, hi)
         if np.isfinite(res.fun) and -res.fun > best_s and allowed(x[None, :])[0]:
             best_x, best_s = x, -res.fun
@@ -192,17 +191,8 @@ def thompson_batch(gp: GaussianProcess, lo: np.ndarray, hi: np.ndarray, centre: 
 
     Parameters
     ----------
-    gp : GaussianProcess
-        Model of the standardised targets.
-    lo, hi : (d,) ndarray
-        Box searched (unit cube coordinates).
-    centre : (d,) ndarray
-        Design whose neighbours are offered as candidates too (the incumbent).
-    q : int
-        Designs wanted.
-    rng : Generator
-    allowed : callable
-        ``allowed(U) -> bool (m,)``: designs that may be simulated.
+    gp, lo, hi, centre, q, rng, allowed
+        As in :func:`propose_batch`.
     log_feasible : callable, optional
         Log-probability that a design's simulation succeeds; candidates below 1/2 are dropped while any is above.
     n_candidates : int

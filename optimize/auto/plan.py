@@ -57,14 +57,11 @@ class Plan:
         """One line for the result's message."""
         if self.name == "least-squares":
             what = "Gauss-Newton runs on the residuals from multi-level single linkage starts"
+        elif self.name == "global":
+            what = f"one global GP, expected improvement, local polish of the last {self.n_polish}"
         else:
-            if self.name == "global":
-                what = "one global GP, expected improvement"
-            elif self.batch > 1:
-                what = f"Thompson-sampled batches of {self.batch} in a restarted trust region"
-            else:
-                what = "expected improvement in a restarted trust region"
-            what += f", local polish of the last {self.n_polish}"
+            steps = (f"Thompson-sampled batches of {self.batch}" if self.batch > 1 else "expected improvement")
+            what = f"{steps} in a restarted trust region, local polish of the last {self.n_polish}"
         return f"plan {self.name} (d = {dim}, budget {budget}): {self.n_init} Sobol designs, then {what}"
 
 
