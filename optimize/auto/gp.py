@@ -1,6 +1,18 @@
 """A Gaussian process on the unit cube: Matérn-5/2 kernel with one length-scale per variable, hyperparameters by
 maximum marginal likelihood (ML-II), optionally with a weak prior, several starts.
 
+The prior mean is a constant estimated by generalised least squares at the fitted hyperparameters (ordinary
+kriging's mean, the model of DACE and of EGO: Jones, Schonlau & Welch 1998; BoTorch's constant mean fitted by
+maximum likelihood is the same estimate).  The plain average of the targets is a biased estimate of the function's
+level: a minimiser piles its designs into the low basins, so the average sinks, and with it what the model expects
+wherever it has not looked; every unexplored corner then seems promising.  Generalised least squares weighs a
+cluster of correlated designs about as one.  The level's own uncertainty is left out of the variance, as BoTorch
+does: on a smooth function with long length-scales the level is poorly determined, and that term made the far
+corners of a trust region look promising (Rosenbrock-6 at 300 simulations: two of five seeds ended above 250).
+Measured at 30 simulations, 20 seeds, median gap: Hartmann-3 0.0034 -> 0.0037 %, cosine_bowl3 0.21 -> 0.038 %,
+Styblinski-Tang-3 5.1 -> 2.7 %, Hartmann-4 0.65 -> 0.75 %, cosine_bowl4 12.5 -> 10.1 %; at 500, seeds 0-4, median
+best value: Ackley-8 0.49 -> 0.0052, Levy-8 0.090 -> 4e-6; Rosenbrock-6 at 300: 3.75 -> 2.28.
+
 The optional prior on the length-scales is the dimension-scaled log-normal of Hvarfner, Hellsten & Nardi (2024):
 log ℓ ~ N(√2 + ½ log d, √3), derived for many variables, where a few dozen designs leave most length-scales
 undetermined and plain ML-II collapses them onto tiny values (every unexplored point then looks equally
@@ -44,7 +56,7 @@ class GaussianProcess:
     X : (n, d) ndarray
         Designs in the unit cube.
     y : (n,) ndarray
-        Standardised targets (zero prior mean).
+        Standardised targets.
     theta : (d + 2,) ndarray
         log length-scales, log signal variance, log noise variance.
     """
@@ -57,12 +69,16 @@ class GaussianProcess:
         K, _ = _matern(self.X, self.X, self.ell, self.signal)
         K[np.diag_indices_from(K)] += self.noise
         self.L = np.linalg.cholesky(K)
-        self.alpha = cho_solve((self.L, True), self.y)
+        k1 = cho_solve((self.L, True), np.ones(self.y.size))
+        #: The constant prior mean (generalised least squares).
+        self.mean_level = float(k1 @ self.y / k1.sum())
+        self.alpha = cho_solve((self.L, True), self.y - self.mean_level)
 
     def predict(self, U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Posterior mean and standard deviation (of the latent function, no noise) at designs U (m, d)."""
+        """Posterior mean and standard deviation (of the latent function, no noise) at designs U (m, d), the mean
+        level taken as known."""
         Ks, _ = _matern(np.atleast_2d(U), self.X, self.ell, self.signal)
-        mean = Ks @ self.alpha
+        mean = self.mean_level + Ks @ self.alpha
         V = solve_triangular(self.L, Ks.T, lower=True)
         var = np.maximum(self.signal - np.sum(V * V, axis=0), 1e-12 * self.signal)
         return mean, np.sqrt(var)
@@ -81,7 +97,7 @@ class GaussianProcess:
         except np.linalg.LinAlgError:
             w, Q = np.linalg.eigh(C)
             F = Q * np.sqrt(np.maximum(w, 0.0))
-        return Ks @ self.alpha + (F @ rng.standard_normal((U.shape[0], n))).T
+        return self.mean_level + Ks @ self.alpha + (F @ rng.standard_normal((U.shape[0], n))).T
 
     def believe(self, U: np.ndarray) -> GaussianProcess:
         """The same GP with designs U (m, d) added at their posterior mean (the kriging believer of a batch)."""
@@ -101,8 +117,11 @@ def _neg_log_posterior(theta: np.ndarray, X: np.ndarray, y: np.ndarray, prior_mu
         L = np.linalg.cholesky(K)
     except np.linalg.LinAlgError:
         return 1e10, np.zeros_like(theta)
-    alpha = cho_solve((L, True), y)
     Kinv = cho_solve((L, True), np.eye(n))
+    # The mean level profiled out; the gradient needs no term for it, since 1ᵀK⁻¹(y − level·1) = 0 at its estimate.
+    k1 = Kinv.sum(axis=1)
+    y = y - float(k1 @ y / k1.sum())
+    alpha = cho_solve((L, True), y)
     nll = 0.5 * y @ alpha + np.sum(np.log(np.diag(L))) + 0.5 * n * math.log(2 * math.pi)
     A = np.outer(alpha, alpha) - Kinv
     M = A * W

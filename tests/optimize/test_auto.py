@@ -178,3 +178,29 @@ def test_gp_gradient_and_fit():
     assert np.all(sd < 0.1)
     # x3 does not enter y: its length-scale is the longest.
     assert np.argmax(gp.theta[:3]) == 2
+
+
+def test_mean_level_is_the_limit_of_a_random_constant_of_large_variance():
+    # An independent formulation: a zero-mean GP whose kernel has a constant term B·11ᵀ predicts, as B grows, the
+    # generalised least-squares level plus the kriging of the residuals (ordinary kriging, Santner et al. 2003).
+    rng = np.random.default_rng(5)
+    X = np.vstack([0.1 * rng.random((9, 2)), rng.random((3, 2))])  # a cluster in a corner and three apart
+    y = np.concatenate([-1.0 + 0.1 * rng.standard_normal(9), [1.0, 1.5, 0.8]])
+    theta = np.array([np.log(0.15), np.log(0.2), 0.0, np.log(1e-6)])
+    gp = GaussianProcess(X, y, theta)
+    U = np.array([[0.05, 0.05], [0.5, 0.5], [0.95, 0.9], [3.0, 3.0]])
+
+    def k(A, B):
+        D = (A[:, None, :] - B[None, :, :]) / np.exp(theta[:2])
+        r = np.sqrt(np.sum(D * D, axis=2))
+        return (1 + np.sqrt(5) * r + 5 / 3 * r * r) * np.exp(-np.sqrt(5) * r)
+
+    K, Ks, big = k(X, X) + 1e-6 * np.eye(12), k(U, X), 1e5
+    mean, sd = gp.predict(U)
+    np.testing.assert_allclose(mean, (Ks + big) @ np.linalg.solve(K + big, y), atol=1e-4)
+    # The level is plugged in as known (its uncertainty is left out, as BoTorch does): simple kriging's variance.
+    np.testing.assert_allclose(sd**2, np.maximum(1.0 - np.sum(Ks * np.linalg.solve(K, Ks.T).T, axis=1), 1e-12))
+    # Far from every design the model expects the level, not the average the cluster drags down.
+    k1 = np.linalg.solve(K, np.ones(12))
+    assert abs(mean[3] - k1 @ y / k1.sum()) < 1e-9
+    assert mean[3] > y.mean() + 0.3
