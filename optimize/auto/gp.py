@@ -8,10 +8,10 @@ level: a minimiser piles its designs into the low basins, so the average sinks, 
 wherever it has not looked; every unexplored corner then seems promising.  Generalised least squares weighs a
 cluster of correlated designs about as one.  The level's own uncertainty is left out of the variance, as BoTorch
 does: on a smooth function with long length-scales the level is poorly determined, and that term made the far
-corners of a trust region look promising (Rosenbrock-6 at 300 simulations: two of five seeds ended above 250).
-Measured at 30 simulations, 20 seeds, median gap: Hartmann-3 0.0034 -> 0.0037 %, cosine_bowl3 0.21 -> 0.038 %,
-Styblinski-Tang-3 5.1 -> 2.7 %, Hartmann-4 0.65 -> 0.75 %, cosine_bowl4 12.5 -> 10.1 %; at 500, seeds 0-4, median
-best value: Ackley-8 0.49 -> 0.0052, Levy-8 0.090 -> 4e-6; Rosenbrock-6 at 300: 3.75 -> 2.28.
+corners of a trust region look promising (Rosenbrock-6 at 300 simulations left its valley).  Measured with
+``benchmarks/bench_default.py`` (10 seeds; BENCHMARKS.md), median gap at 30 simulations: cosine_bowl3 0.080 -> 0.038 %,
+Hartmann-3 0.0047 -> 0.0035 %, Styblinski-Tang-3 3.19 -> 1.37 %, cosine_bowl4 15.0 -> 10.7 %, Hartmann-4 1.50 ->
+0.56 %; median best value at 500: Ackley-8 0.495 -> 0.0051, Levy-8 0.909 -> 5.6e-6; Rosenbrock-6 at 300 2.35 -> 2.50.
 
 The optional prior on the length-scales is the dimension-scaled log-normal of Hvarfner, Hellsten & Nardi (2024):
 log ℓ ~ N(√2 + ½ log d, √3), derived for many variables, where a few dozen designs leave most length-scales
