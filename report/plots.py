@@ -114,7 +114,9 @@ def plot_feasible_slices(problem: DesignProblem, path: str | Path, marks: Mappin
         if value is not None:
             X[:, 0] = value
         X[:, ix], X[:, iy] = GX.ravel(), GY.ravel()
-        feasible = problem.feasible(X).reshape(GX.shape)
+        # The margins once: the feasible region and each constraint's contour come from the same array.
+        M = problem.constraint_margins(X) if problem.constraints else np.zeros((X.shape[0], 0))
+        feasible = (problem.in_box(X) & np.all(M >= 0.0, axis=1)).reshape(GX.shape)
         ax.contourf(GX, GY, feasible.astype(float), levels=[0.5, 1.5], colors=["#cfe8cf"])
         if model is not None and d == 2:
             Z = np.where(feasible.ravel() & model.contains(X), model.predict(X), np.nan).reshape(GX.shape)
@@ -124,7 +126,6 @@ def plot_feasible_slices(problem: DesignProblem, path: str | Path, marks: Mappin
                 ax.clabel(cs, fontsize=7, fmt="%.3g")
                 handles["model"] = plt.Line2D([], [], color="0.35", lw=0.7, label=f"model {problem.objective}")
         if problem.constraints:
-            M = problem.constraint_margins(X)
             for k, name in enumerate(problem.constraints):
                 values = np.nan_to_num(M[:, k].reshape(GX.shape), nan=-1.0, neginf=-1.0)
                 if values.min() < 0 < values.max():
