@@ -146,7 +146,9 @@ def planned_designs(space: ModelSpace, options: SparseOptions, n_lines: int, sam
 
     What :func:`build_stage` simulates, exactly: the plan before a run counts these (and finds them in the store).
     """
-    key = (id(space.problem), repr(sorted(options.to_dict().items())), n_lines, samples_per_line, paper, max_samples)
+    # The fingerprint and the bounds too: a mutable problem changed in place between two calls gets a new plan.
+    key = (id(space.problem), space.problem.fingerprint(), np.asarray(space.box, dtype=float).tobytes(),
+           repr(sorted(options.to_dict().items())), n_lines, samples_per_line, paper, max_samples)
     held = _PLANS.get(key)
     if held is not None and held[0]() is space.problem:
         plan, cov, designs = held[1]
