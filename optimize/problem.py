@@ -286,12 +286,17 @@ class DesignProblem:
                              f"({X.shape[0]}, {len(self.constraints)}) for constraints {list(self.constraints)}")
         return np.where(np.isnan(M), -np.inf, M)
 
-    def feasible(self, X: Any) -> np.ndarray:
-        """Designs (n, d) inside the bounds and satisfying every constraint."""
+    def feasible(self, X: Any, margins: np.ndarray | None = None) -> np.ndarray:
+        """Designs (n, d) inside the bounds and satisfying every constraint.
+
+        ``margins``: :meth:`constraint_margins` of all of X, when the caller has them already (a figure that also
+        draws each constraint's contour); otherwise they are computed for the designs inside the bounds only.
+        """
         X = as_design_array(X, self.dim)
         ok = self.in_box(X)
         if len(self.constraints) and ok.any():
-            ok[ok] = np.all(self.constraint_margins(X[ok]) >= 0.0, axis=1)
+            M = self.constraint_margins(X[ok]) if margins is None else np.asarray(margins, dtype=float)[ok]
+            ok[ok] = np.all(M >= 0.0, axis=1)
         return ok
 
     def output_label(self, name: str) -> str:

@@ -115,8 +115,8 @@ def plot_feasible_slices(problem: DesignProblem, path: str | Path, marks: Mappin
             X[:, 0] = value
         X[:, ix], X[:, iy] = GX.ravel(), GY.ravel()
         # The margins once: the feasible region and each constraint's contour come from the same array.
-        M = problem.constraint_margins(X) if problem.constraints else np.zeros((X.shape[0], 0))
-        feasible = (problem.in_box(X) & np.all(M >= 0.0, axis=1)).reshape(GX.shape)
+        M = problem.constraint_margins(X) if problem.constraints else None
+        feasible = problem.feasible(X, margins=M).reshape(GX.shape)
         ax.contourf(GX, GY, feasible.astype(float), levels=[0.5, 1.5], colors=["#cfe8cf"])
         if model is not None and d == 2:
             Z = np.where(feasible.ravel() & model.contains(X), model.predict(X), np.nan).reshape(GX.shape)
