@@ -295,7 +295,14 @@ class DesignProblem:
         X = as_design_array(X, self.dim)
         ok = self.in_box(X)
         if len(self.constraints) and ok.any():
-            M = self.constraint_margins(X[ok]) if margins is None else np.asarray(margins, dtype=float)[ok]
+            if margins is None:
+                M = self.constraint_margins(X[ok])
+            else:
+                M = np.asarray(margins, dtype=float)
+                if M.shape != (X.shape[0], len(self.constraints)):
+                    raise InputError(f"{self.name}: margins of shape {M.shape} given for {X.shape[0]} designs; "
+                                     f"expected ({X.shape[0]}, {len(self.constraints)}), one column a constraint")
+                M = M[ok]
             ok[ok] = np.all(M >= 0.0, axis=1)
         return ok
 
