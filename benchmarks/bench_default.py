@@ -4,7 +4,10 @@ through :func:`mechopt.minimize` (store, sampler, failure handling: what a user 
 Every run appends one JSON line to ``--out`` (function, method, budget, seed, best value, gap, evaluations,
 failures, seconds, whether it raised); runs already in that file are not repeated, so a table can be built over
 several invocations (``--table`` prints it from the file alone).  Printed per cell: median gap (f_best − f_min) in %
-of the function's range, median best value, seeds in the global basin, median seconds per run.
+of the function's range, median best value, seeds in the global basin, median seconds per run.  Then, for each
+peer, how often a run of the default ends lower than a run of the peer and the two-sided Mann-Whitney p-value of
+the two samples of gaps: whether a difference of medians is more than seed luck.  (A seed's number gives two
+methods unrelated random draws, so runs are compared as two samples, not in pairs.)
 
 Run, e.g.::
 
@@ -24,6 +27,7 @@ import warnings
 from pathlib import Path
 
 import numpy as np
+from scipy.stats import mannwhitneyu
 
 if __package__ in (None, ""):
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
@@ -104,6 +108,31 @@ def table(path: Path, methods: list[str] | None = None) -> None:
         print(" ".join(line))
 
 
+def rank_test(path: Path, reference: str = "auto") -> None:
+    """Per cell and peer: the probability that a run of ``reference`` ends with a smaller gap than a run of the
+    peer (ties count half; the Mann-Whitney U statistic over n·m) and the two-sided Mann-Whitney p-value."""
+    cells: dict[tuple, dict[str, list[float]]] = {}
+    for r in load(path):
+        cells.setdefault((r["dim"], r["function"], r["budget"]), {}).setdefault(r["method"], []).append(r["gap"])
+    lines = []
+    for (dim, name, budget), by_method in sorted(cells.items()):
+        ref = by_method.get(reference)
+        for peer, gaps in sorted(by_method.items()):
+            if peer == reference or not ref:
+                continue
+            # A run that raised (an infinite gap) ranks last; the test needs finite values.
+            worst = 2.0 * max([abs(g) for g in ref + gaps if math.isfinite(g)] + [1.0])
+            a = np.nan_to_num(np.array(ref, dtype=float), posinf=worst)
+            b = np.nan_to_num(np.array(gaps, dtype=float), posinf=worst)
+            test = mannwhitneyu(a, b, alternative="two-sided")
+            share = float(test.statistic) / (a.size * b.size)
+            lines.append(f"{name:18s} {dim:2d} {budget:6d} {peer:>16s} {1.0 - share:13.2f} {test.pvalue:10.3g}")
+    if lines:
+        print(f"\n{reference} against each peer: P({reference} ends lower) over all pairs of runs, Mann-Whitney p")
+        print(f"{'function':18s} {'d':>2s} {'budget':>6s} {'peer':>16s} {'P(lower)':>13s} {'p':>10s}")
+        print("\n".join(lines))
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--functions", nargs="+", default=list(SUITE), choices=list(SUITE))
@@ -116,6 +145,7 @@ def main() -> None:
     if not args.table:
         run_all(args)
     table(Path(args.out), None if args.table else args.methods)
+    rank_test(Path(args.out))
 
 
 if __name__ == "__main__":
