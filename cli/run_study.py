@@ -117,7 +117,7 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
     from mechopt.report.study_report import write_outputs
 
     problem = study.problem
-    check_method(method, problem.dim, study.name)
+    check_method(method, problem.dim, study.name, options.budget, n_lines=options.n_lines)
     out = check_output_folder(out)
     store_path = Path(store_path) if store_path else out / "samples.sqlite"
     timings: dict[str, float] = {}
@@ -170,7 +170,7 @@ def plan_study(study: Study, options: SparseOptions, workers: int | None = None,
     Parameters are those of :func:`run_study`; ``store_path`` is read when it exists (a resumed run costs only the
     designs it lacks) and never created.
     """
-    check_method(method, study.problem.dim, study.name)
+    check_method(method, study.problem.dim, study.name, options.budget, n_lines=options.n_lines)
     if scheduler is not None:
         with make_executor(workers=workers, scheduler=scheduler) as executor:  # only to count the cluster's workers
             n_workers = executor.workers

@@ -41,6 +41,7 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
         check_budget(args.budget)
     check_method(args.method, study.problem.dim, study.name)
     options = study_options(study, overrides(args), log=print)
+    check_method(args.method, study.problem.dim, study.name, options.budget, n_lines=options.n_lines)
     out_arg = Path(args.out or f"{study.name}-study")
     if args.dry_run:
         store = Path(args.store) if args.store else out_arg / "samples.sqlite"

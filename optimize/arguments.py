@@ -11,7 +11,7 @@ import numpy as np
 from mechopt.errors import InputError
 
 __all__ = ["AUTO_METHOD", "MIN_BUDGET", "SPARSE_METHODS", "available_methods", "check_budget", "check_method",
-           "check_seed", "check_workers"]
+           "check_seed", "check_workers", "method_min_budget"]
 
 #: The fewest simulations any method is given: a model needs a few designs before it can propose one.
 MIN_BUDGET = 3
@@ -61,9 +61,10 @@ def check_workers(workers: Any) -> int | None:
     return workers
 
 
-def check_method(method: Any, dim: int, name: str = "the problem", budget: int | None = None) -> None:
+def check_method(method: Any, dim: int, name: str = "the problem", budget: int | None = None,
+                 n_lines: int | None = None) -> None:
     """Refuse an unknown method name, a line-model method outside its 2 to 4 design variables, or a budget below
-    the default method's 2d + 2.
+    the method's own minimum (:func:`method_min_budget`).
 
     Parameters
     ----------
@@ -74,7 +75,10 @@ def check_method(method: Any, dim: int, name: str = "the problem", budget: int |
     name : str
         The problem's name, for the message.
     budget : int, optional
-        The budget (checked against the default method's minimum when given).
+        The budget (checked against the method's minimum when given).
+    n_lines : int, optional
+        Lines of the sparse method's global model when the caller's options set them (default: the plan scaled to
+        the budget).
     """
     if callable(method):
         return
@@ -83,6 +87,29 @@ def check_method(method: Any, dim: int, name: str = "the problem", budget: int |
     if method in SPARSE_METHODS and not 2 <= dim <= 4:
         raise InputError(f"method {method!r} handles 2 to 4 design variables; {name!r} has {dim}: choose 'auto' "
                          "or a baseline (`--method`, `mechopt methods`)")
-    if method == AUTO_METHOD and budget is not None and budget < 2 * dim + 2:
-        raise InputError(f"budget = {budget}: method {method!r} needs at least 2d + 2 = {2 * dim + 2} simulations "
-                         f"for the {dim} variables of {name!r}")
+    if budget is None:
+        return
+    need, why = method_min_budget(method, dim, budget, n_lines)
+    if budget < need:
+        raise InputError(f"budget = {budget}: method {method!r} needs at least {why} = {need} simulations for the "
+                         f"{dim} variables of {name!r}")
+
+
+def method_min_budget(method: str, dim: int, budget: int = MIN_BUDGET, n_lines: int | None = None) -> tuple[int, str]:
+    """The fewest simulations a mechopt method is given for ``dim`` variables, and the rule in words.
+
+    ``auto`` needs 2d + 2 (its Sobol design and a model step); ``sparse`` two samples on each line of its global
+    model and one to confirm the model's candidate (lines: ``n_lines``, or the plan scaled to ``budget``), since a
+    line plan trimmed to fewer would run past the budget; ``sparse-global`` 10·d (its lines and the steps on them).
+    A baseline needs :data:`MIN_BUDGET`.
+    """
+    if method == AUTO_METHOD:
+        return 2 * dim + 2, "2d + 2"
+    if method == "sparse":
+        from mechopt.optimize.sparse.options import SparseOptions
+
+        lines = int(n_lines) if n_lines is not None else SparseOptions.for_budget(budget, dim).n_lines
+        return 2 * lines + 1, f"2 samples on each of its {lines} lines + 1"
+    if method == "sparse-global":
+        return 10 * dim, "10d"
+    return MIN_BUDGET, str(MIN_BUDGET)

@@ -53,7 +53,7 @@ def _check_arguments(problem: Any, budget: Any, method: Any, seed: Any, workers:
         raise InputError(f"problem must be a mechopt.DesignProblem, got {type(problem).__name__}")
     problem.check()
     check_budget(budget)
-    check_method(method, problem.dim, problem.name, budget)
+    check_method(method, problem.dim, problem.name)
     check_seed(seed)
     check_workers(workers)
 
@@ -118,6 +118,7 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
     """
     _check_arguments(problem, budget, method, seed, workers)
     opts = _options(problem, options, int(budget), int(seed))
+    check_method(method, problem.dim, problem.name, opts.budget, n_lines=opts.n_lines)
     log = log or (lambda _line: None)
     t0 = time.perf_counter()
     with contextlib.ExitStack() as stack:

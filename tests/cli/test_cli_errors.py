@@ -164,3 +164,13 @@ def test_ctrl_c_leaves_one_line_and_an_intact_store(tmp_path):
     with sqlite3.connect(store) as con:
         assert con.execute("PRAGMA integrity_check").fetchone()[0] == "ok"
         assert con.execute("SELECT COUNT(*) FROM samples").fetchone()[0] >= 5
+
+
+def test_budget_below_the_methods_minimum(tmp_path):
+    # The study's own default method (sparse) and an explicit one: refused before the plan is printed, nothing
+    # simulated, no output folder made.
+    one_line(mechopt("study", "ventilator", "--budget", "3", "--out", str(tmp_path / "v"), "--no-progress"),
+             "budget = 3", "'sparse'", "= 7 simulations")
+    one_line(mechopt("study", "hartmann6", "--budget", "10", "--out", str(tmp_path / "h"), "--no-progress"),
+             "budget = 10", "'auto'", "2d + 2 = 14")
+    assert not (tmp_path / "v").exists() and not (tmp_path / "h").exists()
