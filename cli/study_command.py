@@ -40,8 +40,10 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
     if args.budget is not None:
         check_budget(args.budget)
     check_method(args.method, study.problem.dim, study.name)
-    options = study_options(study, overrides(args), log=print)
+    # Checked on the options first, silently: a refused budget prints nothing but its one line.
+    options = study_options(study, overrides(args))
     check_method(args.method, study.problem.dim, study.name, options.budget, n_lines=options.n_lines)
+    options = study_options(study, overrides(args), log=print)
     out_arg = Path(args.out or f"{study.name}-study")
     if args.dry_run:
         store = Path(args.store) if args.store else out_arg / "samples.sqlite"

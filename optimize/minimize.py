@@ -117,8 +117,7 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
         A bad argument, before any simulation.
     """
     _check_arguments(problem, budget, method, seed, workers)
-    opts = _options(problem, options, int(budget), int(seed))
-    check_method(method, problem.dim, problem.name, opts.budget, n_lines=opts.n_lines)
+    opts = _checked_options(problem, method, options, int(budget), int(seed))
     log = log or (lambda _line: None)
     t0 = time.perf_counter()
     with contextlib.ExitStack() as stack:
@@ -156,6 +155,15 @@ def _options(problem: DesignProblem, options: Mapping[str, Any] | SparseOptions 
     given = dict(options or {})
     given.setdefault("validation_lines", 0)
     return SparseOptions.for_budget(budget, problem.dim, seed, **given)
+
+
+def _checked_options(problem: DesignProblem, method: str | Callable[..., Any],
+                     options: Mapping[str, Any] | SparseOptions | None, budget: int, seed: int) -> SparseOptions:
+    """:func:`_options`, after refusing a budget below the method's minimum (the sparse method's depends on its
+    lines, which the options may set)."""
+    opts = _options(problem, options, budget, seed)
+    check_method(method, problem.dim, problem.name, opts.budget, n_lines=opts.n_lines)
+    return opts
 
 
 def _open_store(store: str | Path | SampleStore | None, stack: contextlib.ExitStack) -> SampleStore:

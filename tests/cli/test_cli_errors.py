@@ -169,8 +169,13 @@ def test_ctrl_c_leaves_one_line_and_an_intact_store(tmp_path):
 def test_budget_below_the_methods_minimum(tmp_path):
     # The study's own default method (sparse) and an explicit one: refused before the plan is printed, nothing
     # simulated, no output folder made.
-    one_line(mechopt("study", "ventilator", "--budget", "3", "--out", str(tmp_path / "v"), "--no-progress"),
-             "budget = 3", "'sparse'", "= 7 simulations")
+    proc = mechopt("study", "ventilator", "--budget", "3", "--out", str(tmp_path / "v"), "--no-progress")
+    one_line(proc, "budget = 3", "'sparse'", "= 7 simulations")
+    assert not proc.stdout.strip(), proc.stdout
+    proc = mechopt("study", "ventilator", "--budget", "20", "--method", "sparse-global", "--out", str(tmp_path / "g"),
+                   "--no-progress")
+    one_line(proc, "budget = 20", "10d = 30")
+    assert not proc.stdout.strip(), proc.stdout  # not even the line that scales the study's plan to the budget
     one_line(mechopt("study", "hartmann6", "--budget", "10", "--out", str(tmp_path / "h"), "--no-progress"),
              "budget = 10", "'auto'", "2d + 2 = 14")
     assert not (tmp_path / "v").exists() and not (tmp_path / "h").exists()
