@@ -120,10 +120,10 @@ def rank_test(path: Path, reference: str = "auto") -> None:
         for peer, gaps in sorted(by_method.items()):
             if peer == reference or not ref:
                 continue
-            # A run that raised (an infinite gap) ranks last; the test needs finite values.
+            # A run that raised (an infinite gap) or found nothing (NaN) ranks last; the test needs finite values.
             worst = 2.0 * max([abs(g) for g in ref + gaps if math.isfinite(g)] + [1.0])
-            a = np.nan_to_num(np.array(ref, dtype=float), posinf=worst)
-            b = np.nan_to_num(np.array(gaps, dtype=float), posinf=worst)
+            a = np.nan_to_num(np.array(ref, dtype=float), nan=worst, posinf=worst)
+            b = np.nan_to_num(np.array(gaps, dtype=float), nan=worst, posinf=worst)
             test = mannwhitneyu(a, b, alternative="two-sided")
             share = float(test.statistic) / (a.size * b.size)
             lines.append(f"{name:18s} {dim:2d} {budget:6d} {peer:>16s} {1.0 - share:13.2f} {test.pvalue:10.3g}")

@@ -159,8 +159,8 @@ def _options(problem: DesignProblem, options: Mapping[str, Any] | SparseOptions 
 
 def _checked_options(problem: DesignProblem, method: str | Callable[..., Any],
                      options: Mapping[str, Any] | SparseOptions | None, budget: int, seed: int) -> SparseOptions:
-    """:func:`_options`, after refusing a budget below the method's minimum (the sparse method's depends on its
-    lines, which the options may set)."""
+    """The options of :func:`_options`; a budget below the method's minimum is refused on them, since the sparse
+    method's minimum depends on its lines, which the options may set."""
     opts = _options(problem, options, budget, seed)
     check_method(method, problem.dim, problem.name, opts.budget, n_lines=opts.n_lines)
     return opts
