@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import os
 import tempfile
 import time
 from collections.abc import Callable, Mapping
@@ -48,7 +49,7 @@ def _baselines() -> dict[str, Callable[..., Any]]:
     return BASELINES
 
 
-def _check_arguments(problem: Any, budget: Any, method: Any, seed: Any, workers: Any) -> None:
+def _check_arguments(problem: Any, budget: Any, method: Any, seed: Any, workers: Any, store: Any) -> None:
     if not isinstance(problem, DesignProblem):
         raise InputError(f"problem must be a mechopt.DesignProblem, got {type(problem).__name__}")
     problem.check()
@@ -56,6 +57,8 @@ def _check_arguments(problem: Any, budget: Any, method: Any, seed: Any, workers:
     check_method(method, problem.dim, problem.name)
     check_seed(seed)
     check_workers(workers)
+    if store is not None and not isinstance(store, str | os.PathLike | SampleStore):
+        raise InputError(f"store = {store!r}: expected the path of an SQLite file or a SampleStore")
 
 
 def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[..., Any] = DEFAULT_METHOD,
@@ -116,7 +119,7 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
     InputError
         A bad argument, before any simulation.
     """
-    _check_arguments(problem, budget, method, seed, workers)
+    _check_arguments(problem, budget, method, seed, workers, store)
     opts = _checked_options(problem, method, options, int(budget), int(seed))
     log = log or (lambda _line: None)
     t0 = time.perf_counter()

@@ -110,6 +110,8 @@ def test_baselines_run_through_the_same_entry_point(method):
     ({"workers": 0}, "workers = 0"),
     ({"options": {"n_lines": "seven"}}, "n_lines = 'seven'"),
     ({"options": {"lines": 7}}, "unknown option lines"),
+    ({"store": 123}, "store = 123"),
+    ({"method": "sparse", "budget": 6}, "needs at least 2 samples on each of its 3 lines + 1 = 7"),
 ])
 def test_bad_arguments_are_one_line_errors_before_any_work(kwargs, expected):
     with pytest.raises(mechopt.InputError) as info:
