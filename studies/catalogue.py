@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import functools
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -26,6 +27,8 @@ __all__ = ["STUDIES_DIR", "Study", "available_studies", "load_study"]
 
 STUDIES_DIR = PACKAGED_STUDIES
 
+#: The overrides :func:`load_study` passes to a mechanism plug-in (the command line's ``--engine``).
+OVERRIDES = ("engine",)
 #: Sections the engine reads; a plug-in declares its own in :data:`PLUGIN_SECTIONS`-style checks of its own.
 ENGINE_SECTIONS = {"name", "description", "kind", "variables", "designs", "surrogate", "paper", "compare",
                    "validation", "simulator"}
@@ -134,7 +137,7 @@ def load_study(name_or_path: str | Path, options: dict[str, Any] | None = None) 
     name_or_path : str or Path
         A shipped study's name (``"ventilator"``) or a ``.toml`` path.
     options : dict, optional
-        Overrides passed to the mechanism plug-in (``{"engine": "analytic"}``).
+        Overrides passed to the mechanism plug-in (``{"engine": "analytic"}``; keys: :data:`OVERRIDES`).
 
     Returns
     -------
@@ -145,12 +148,24 @@ def load_study(name_or_path: str | Path, options: dict[str, Any] | None = None) 
     StudyError
         Unknown study, malformed TOML, or a missing / unknown / ill-typed key (the message names it).
     """
+    _check_overrides(options)
     suite = _suite_study(str(name_or_path))
     if suite is not None:
         return suite
     path = _resolve(name_or_path)
     items = tuple(sorted((k, v) for k, v in (options or {}).items() if v is not None))
     return _load_cached(str(path), path.stat().st_mtime_ns, items)
+
+
+def _check_overrides(options: Any) -> None:
+    """Refuse overrides that are not a mapping of :data:`OVERRIDES` (a mistyped key would be ignored)."""
+    if options is None:
+        return
+    if not isinstance(options, Mapping):
+        raise StudyError(f"options = {options!r}: expected a mapping of overrides such as {{'engine': 'analytic'}}")
+    for key in options:
+        if key not in OVERRIDES:
+            raise StudyError(f"unknown override {key!r}; expected one of {', '.join(OVERRIDES)}")
 
 
 @functools.lru_cache(maxsize=16)
