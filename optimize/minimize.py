@@ -110,7 +110,8 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
     Returns
     -------
     OptimizeResult
-        ``x``, ``fun``, ``outputs``, ``nfev``, ``success``, ``message``, the accounting of the parallel run
+        ``x``, ``fun``, ``outputs``, ``nfev``, ``success``, ``message``, ``nfailed`` and ``failures`` (each failed
+        design, in the variables' units, with the reason), the accounting of the parallel run
         (``rounds``, ``batch_size``, ``idle_share``, ``waiting_s``, ``method_s``) and, for the sparse method,
         ``model``, ``stages`` and ``validation``.
 
@@ -132,15 +133,27 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
             result["validation"] = validate(result.model, ModelSpace(problem), sampler, opts.validation_lines,
                                             opts.validation_points, opts.seed, f_min=result.fun)
             result["trust"] = study_trust(result.stages[0], result.pipeline.best, result.validation)
-        result["nnew"], result["nreused"] = sampler.n_computed, sampler.n_cached
-        result["nfailed"] = len(sampler.failures)
-        if result.success:
-            record = sampler.records(np.asarray(result.x)[None, :], desc="optimum")[0]
-            result["outputs"] = dict(record.outputs)
-        result["sampling"] = sampler.summary()
-        result.update(parallel_accounting(sampler))
+        _account(result, sampler)
     result["wall_time_s"] = time.perf_counter() - t0
     return result
+
+
+def _account(result: OptimizeResult, sampler: Sampler) -> None:
+    """What the run spent, reused and lost: counts, every failed design with its reason, the optimum's outputs.
+
+    A run that found no design (every simulation failed, as when ``evaluate`` itself is wrong) says in its message
+    why the first one failed: the count alone leaves the user to guess.
+    """
+    result["nnew"], result["nreused"] = sampler.n_computed, sampler.n_cached
+    result["nfailed"] = len(sampler.failures)
+    result["failures"] = [(np.array(d, dtype=float), error) for d, error in sampler.failures.values()]
+    if result.success:
+        record = sampler.records(np.asarray(result.x)[None, :], desc="optimum")[0]
+        result["outputs"] = dict(record.outputs)
+    elif result["failures"]:
+        result["message"] = f"{result.message}; {result.nfailed} failed, the first with: {result.failures[0][1]}"
+    result["sampling"] = sampler.summary()
+    result.update(parallel_accounting(sampler))
 
 
 def parallel_accounting(sampler: Sampler) -> dict[str, Any]:

@@ -21,3 +21,23 @@ def test_the_line_model_hands_over_when_failures_leave_too_few_lines():
     problem = SUITE["failing_hartmann3"]()
     result = mechopt.minimize(problem, budget=100, method="sparse", seed=0)
     assert "the line model could not be built" in result.message and "plan global" in result.message
+
+
+def test_a_run_whose_every_simulation_fails_says_why():
+    # An evaluate that returns a number instead of its outputs: every design fails the same way, and the result
+    # names the reason, not only the count; each failed design is listed with its reason.
+    import mechopt
+
+    class Wrong(mechopt.DesignProblem):
+        name = "wrong"
+        variables = (mechopt.Variable("a", 5.0, 40.0, "mm"), mechopt.Variable("b", 5.0, 40.0, "mm"))
+        outputs = ("f",)
+        objective = "f"
+
+        def evaluate(self, x):
+            return float(x[0])
+
+    r = mechopt.minimize(Wrong(), 10, seed=0)
+    assert not r.success and r.nfailed == 10 == len(r.failures)
+    assert "the first with: evaluate returned float, expected a dict with outputs ['f']" in r.message
+    assert all(5.0 <= x[0] <= 40.0 and "evaluate returned float" in why for x, why in r.failures)
