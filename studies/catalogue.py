@@ -29,8 +29,9 @@ STUDIES_DIR = PACKAGED_STUDIES
 
 #: The overrides :func:`load_study` passes to a mechanism plug-in (the command line's ``--engine``).
 OVERRIDES = ("engine",)
-#: Sections the engine reads; a plug-in declares its own in :data:`PLUGIN_SECTIONS`-style checks of its own.
-ENGINE_SECTIONS = {"name", "description", "kind", "variables", "designs", "surrogate", "paper", "compare",
+#: Top-level keys the engine reads (a plug-in reads its own sections through :meth:`StudyFile.table`, which
+#: records them); any other key of a study file is refused.
+ENGINE_SECTIONS = {"name", "description", "kind", "method", "variables", "designs", "surrogate", "paper", "compare",
                    "validation", "simulator"}
 
 
@@ -201,6 +202,10 @@ def _load_cached(path_str: str, _mtime: int, options: tuple) -> Study:
         raise StudyError(f"{path.name}: {exc}") from None
     designs = _designs(file, problem)
     paper = file.table("paper", required=False)
+    unread = sorted(set(config) - ENGINE_SECTIONS - file.read)
+    if unread:
+        raise StudyError(f"{path.name}: unknown key {unread[0]}; kind {kind!r} reads "
+                         f"{', '.join(sorted(ENGINE_SECTIONS | file.read))}")
     method = config.get("method", "")
     if not isinstance(method, str):
         raise StudyError(f"{path.name}: key method must be a method's name (`mechopt methods`), got {method!r}")

@@ -39,6 +39,9 @@ class StudyFile:
     path: Path
     config: dict[str, Any] = field(default_factory=dict)
     packaged: str | None = None
+    #: Top-level sections read through :meth:`table` so far: the catalogue refuses a key nothing read (a misspelt
+    #: section would otherwise be ignored, and its settings with it).
+    read: set[str] = field(default_factory=set, compare=False, repr=False)
 
     @property
     def where(self) -> str:
@@ -57,6 +60,7 @@ class StudyFile:
         required : bool
             Raise when the section is missing (else return ``{}``).
         """
+        self.read.add(key.split(".")[0])
         value: Any = self.config
         for part in key.split("."):
             value = value.get(part) if isinstance(value, dict) else None
