@@ -52,6 +52,10 @@ def run_feasible(args: argparse.Namespace, rest: list[str]) -> int:
 
     study = load(args)
     problem = study.problem
+    if not problem.constraints:
+        # A figure of a box that is feasible everywhere would be one flat colour.
+        print(f"{study.name!r} declares no constraints: every design in its box is feasible; no figure drawn")
+        return 0
     out = check_output_folder(Path(args.out or f"{study.name}-study"))
     marks = _marks(study, out)
     files = [plot_feasible_slices(problem, out / "figures" / "feasible_slices_all_designs.png", marks=marks,
@@ -71,9 +75,10 @@ def run_feasible(args: argparse.Namespace, rest: list[str]) -> int:
 def run_truth(args: argparse.Namespace, rest: list[str]) -> int:
     """Brute-force the study's optimum (cached in the output folder) and print it."""
     from mechopt.cli.run_study import check_output_folder
-    from mechopt.optimize.ground_truth import load_or_compute
+    from mechopt.optimize.ground_truth import batch_evaluator, load_or_compute
 
     study = load(args)
+    batch_evaluator(study.problem)  # refused before the output folder is made
     out = check_output_folder(Path(args.out or f"{study.name}-study"))
     truth = load_or_compute(study.problem, out / f"ground_truth_{args.truth_grid:g}.json", args.truth_grid)
     print(f"ground truth of {study.name}: {study.problem.describe(np.array(truth.x))}, {study.problem.objective} "

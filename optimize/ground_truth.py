@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -23,7 +24,7 @@ from mechopt.optimize.sparse.feasible_point import pull_into_feasible
 from mechopt.optimize.sparse.space import ModelSpace
 from mechopt.runs.fingerprint import fingerprint
 
-__all__ = ["GroundTruth", "compute_ground_truth", "load_or_compute"]
+__all__ = ["GroundTruth", "batch_evaluator", "compute_ground_truth", "load_or_compute"]
 
 
 @dataclass
@@ -64,7 +65,14 @@ def truth_key(problem: DesignProblem, step: float) -> str:
     return fingerprint({"problem": problem.fingerprint(), "bounds": problem.bounds.tolist(), "step": step})[:16]
 
 
-def _batch(problem: DesignProblem):
+def batch_evaluator(problem: DesignProblem) -> Callable[[np.ndarray], np.ndarray]:
+    """The problem's ``evaluate_batch``, or a one-line error: a grid needs a fast vectorised evaluator.
+
+    Raises
+    ------
+    MechoptError
+        The problem has none.
+    """
     fn = getattr(problem, "evaluate_batch", None)
     if fn is None:
         raise MechoptError(f"problem {problem.name!r} has no fast batch evaluator (evaluate_batch); its ground truth "
@@ -74,7 +82,7 @@ def _batch(problem: DesignProblem):
 
 def evaluate_grid(problem: DesignProblem, axes: list[np.ndarray], chunk: int = 400_000):
     """Best feasible design on the tensor grid ``axes``, its objective, the designs evaluated and feasible."""
-    batch = _batch(problem)
+    batch = batch_evaluator(problem)
     mesh = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, len(axes))
     best_x, best_f, n_feasible = None, np.inf, 0
     for lo in range(0, mesh.shape[0], chunk):
@@ -94,7 +102,7 @@ def evaluate_grid(problem: DesignProblem, axes: list[np.ndarray], chunk: int = 4
 
 def polish(problem: DesignProblem, x0: np.ndarray) -> tuple[np.ndarray, float]:
     """SLSQP from ``x0`` on the batch evaluator, with the margins as constraints and the box as bounds."""
-    batch = _batch(problem)
+    batch = batch_evaluator(problem)
 
     def objective(x):
         value = float(np.asarray(batch(np.asarray(x, float)[None, :]), dtype=float)[0])

@@ -179,3 +179,12 @@ def test_budget_below_the_methods_minimum(tmp_path):
     one_line(mechopt("study", "hartmann6", "--budget", "10", "--out", str(tmp_path / "h"), "--no-progress"),
              "budget = 10", "'auto'", "2d + 2 = 14")
     assert not (tmp_path / "v").exists() and not (tmp_path / "h").exists()
+
+
+def test_truth_and_feasible_make_no_folder_for_nothing(tmp_path):
+    # A study with no batch evaluator: refused before the output folder is made.  A study with no constraints:
+    # said in a line, and no flat one-colour figure drawn.
+    one_line(mechopt("truth", "--study", "rowing", "--out", str(tmp_path / "r")), "no fast batch evaluator")
+    proc = mechopt("feasible", "--study", "hartmann6", "--out", str(tmp_path / "h"))
+    assert proc.returncode == 0 and "declares no constraints" in proc.stdout, proc.stdout + proc.stderr
+    assert not (tmp_path / "r").exists() and not (tmp_path / "h").exists()
