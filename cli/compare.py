@@ -264,6 +264,11 @@ def check_methods(methods: list[str] | None, budgets: Iterable[int], gp_max_budg
         if unknown:
             raise InputError(f"unknown method {unknown[0]!r}; expected some of {', '.join(names)}")
         names = [n for n in names if n in methods]
+        for name in methods:
+            wrong = [d for d in dims if OUR_METHODS.get(name) in SPARSE_METHODS and not 2 <= d <= 4]
+            if wrong:
+                raise InputError(f"--methods {name}: method {OUR_METHODS[name]!r} handles 2 to 4 design variables, a "
+                                 f"study compared has {wrong[0]}; use mechopt-auto or a baseline")
     check_limits(methods, budgets, gp_max_budget, dims)
     return names
 
@@ -291,7 +296,7 @@ def run_one(problem: DesignProblem, truth: GroundTruth, name: str, budget: int, 
     """
     t0 = time.perf_counter()
     outcome = _Outcome()
-    message = ""
+    message = refused = ""
     try:
         if name in BASELINES:
             method: Any = _guarded(name, BASELINES[name], outcome)
@@ -301,10 +306,14 @@ def run_one(problem: DesignProblem, truth: GroundTruth, name: str, budget: int, 
         x = np.asarray(res.x) if res.success else None
         nfev, message = int(res.nfev), " ".join(str(res.message).split())
     except (SurrogateError, MechoptError) as exc:
-        # Too small a budget for one of our methods is a result of the comparison, not a crash of it.
+        # Too small a budget for one of our methods is a result of the comparison, not a crash of it; the table marks
+        # it and says why, instead of an unexplained infinite gap.
         x, nfev, message = None, 0, _one_line(exc)
+        refused = message
     finished, reason = True, ""
-    if outcome.error:
+    if refused:
+        finished, reason = False, f"refused: {refused}"
+    elif outcome.error:
         finished, reason = False, f"raised {outcome.error}"
     elif name in SPENDS_WHOLE_BUDGET and nfev < budget:
         finished, reason = False, f"ended with {budget - nfev} simulations unspent: {message}"

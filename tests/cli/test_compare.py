@@ -169,3 +169,26 @@ def test_smt_ego_beyond_its_limit_is_refused_in_one_line(tmp_path, capsys):
         check_methods(["smt_ego"], [ego_max_budget(8) + 1], dims=[2, 8])
     assert check_methods(["smt_ego"], [500], gp_max_budget=ego_max_budget(8), dims=[8]) == ["smt_ego"]
     assert "smt_ego" in check_methods(None, [500], dims=[8])  # every method: skipped beyond, not refused
+
+
+def test_a_line_model_named_for_a_study_it_cannot_take_is_refused():
+    from mechopt.cli.compare import check_methods
+
+    with pytest.raises(InputError, match="--methods mechopt-global: method 'sparse-global' handles 2 to 4"):
+        check_methods(["mechopt-global"], [60], dims=[6])
+    assert check_methods(["mechopt-global"], [60], dims=[3]) == ["mechopt-global"]
+
+
+def test_a_run_refused_for_its_budget_is_marked_with_the_reason():
+    # Hartmann-4's line plan needs 11 simulations: at 10 the run is refused, and the table says so (it showed an
+    # unexplained infinite gap); at 11 it runs.
+    from mechopt.cli.compare import known_truth, run_one
+    from mechopt.studies.catalogue import load_study
+
+    problem = load_study("hartmann4").problem
+    truth = known_truth(problem)
+    refused = run_one(problem, truth, "mechopt-sparse", 10, 0)
+    assert not refused.finished and refused.nfev == 0
+    assert refused.reason.startswith("refused: InputError: budget = 10") and "= 11 simulations" in refused.reason
+    ran = run_one(problem, truth, "mechopt-sparse", 11, 0)
+    assert ran.finished and 0 < ran.nfev <= 11
