@@ -53,8 +53,7 @@ def study_lines() -> list[str]:
         dim = len(config.get("variables", {}))
         rows.append((name, f"{config.get('kind', '?')}, {dim} variables", str(config.get("description", ""))))
     for name, cls in sorted(SUITE.items()):
-        doc = (cls.__doc__ or name).strip().splitlines()[0].rstrip(".")
-        rows.append((name, f"test function, {cls().dim} variables", doc))
+        rows.append((name, f"test function, {cls().dim} variables", cls.summary()))
     width = max(len(r[0]) for r in rows)
     return [f"{name:<{width}}  {what}: {text}" for name, what, text in rows]
 

@@ -108,8 +108,7 @@ def _suite_study(name: str) -> Study | None:
     cls = test_functions.SUITE.get(name)
     if cls is None:
         return None
-    doc = (cls.__doc__ or name).strip().splitlines()[0]
-    return Study(name=name, path=Path(test_functions.__file__), description=doc, kind="test-function",
+    return Study(name=name, path=Path(test_functions.__file__), description=cls.summary(), kind="test-function",
                  problem=cls())
 
 

@@ -71,6 +71,12 @@ class TestFunction(DesignProblem):
     f_range: ClassVar[float] = np.nan
     range_grid: ClassVar[int] = 0
 
+    @classmethod
+    def summary(cls) -> str:
+        """The docstring's first paragraph on one line, without reST markup: the catalogue's description."""
+        paragraph = (cls.__doc__ or cls.__name__).strip().split("\n\n")[0]
+        return " ".join(paragraph.split()).replace("``", "").rstrip(".")
+
     def function(self, X: np.ndarray) -> np.ndarray:
         """The function at designs X (n, d), shape (n,)."""
         raise NotImplementedError
