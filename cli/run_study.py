@@ -130,6 +130,8 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
         t0 = time.perf_counter()
         result = run_method(problem, method, options, sampler, log)
         timings["optimise_s"] = time.perf_counter() - t0
+        # The objective of each simulation the method asked for, in order (NaN: failed): the progress figure.
+        result["history"] = [value for _, value in sampler.history.values()]
         n_opt = len(sampler.designs)
         timing = sampler.timing()
         result.update(parallel_accounting(sampler))

@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from mechopt.errors import InputError
+from mechopt.report.convergence import plot_convergence
 from mechopt.report.plots import plot_feasible_3d, plot_feasible_slices, plot_validation
 
 __all__ = ["write_outputs"]
@@ -25,8 +26,13 @@ def _figures(run) -> dict[str, str]:
     designs = {k: v for k, v in run.study.reference_designs().items() if run.references[k]["status"] == "ok"}
     designs["optimum"] = np.asarray(run.result.x)
     files.update(problem.figures(designs, fig_dir))
-    files["Feasible region and each constraint's boundary"] = plot_feasible_slices(
-        problem, fig_dir / "feasible_region.png", marks=marks, model=None if stage is None else stage.model)
+    if run.result.get("history"):
+        files["Progress: each simulation and the best so far"] = plot_convergence(
+            run.result.history, fig_dir / "progress.png", label=problem.output_label(problem.objective),
+            reference=None if run.truth is None else run.truth.fun, method=run.result.method)
+    if problem.constraints:  # without constraints the region is the whole box, one flat colour
+        files["Feasible region and each constraint's boundary"] = plot_feasible_slices(
+            problem, fig_dir / "feasible_region.png", marks=marks, model=None if stage is None else stage.model)
     if problem.dim == 3 and stage is not None:
         ends = stage.model.from_u(stage.plan.segment_ends().reshape(-1, 3))
         files["Feasible region, sampling lines and their hull"] = plot_feasible_3d(
@@ -78,6 +84,7 @@ def result_dict(run) -> dict[str, Any]:
         "simulations": {**run.sampling, "model_lines": res.stages[0].n_samples if res.get("stages") else 0},
         "failures": [{"design": problem.design_dict(d), "error": e} for d, e in run.failures],
         "stages": [s.summary() for s in res.get("stages") or []],
+        "history": [float(v) for v in res.get("history") or []],
         "message": res.message,
         "trust": res.get("trust"),
         "validation": None if val is None else {
@@ -219,11 +226,13 @@ def report_markdown(r: dict[str, Any], study) -> str:
     if r["validation"]:
         lines += _validation_paragraph(r["validation"], obj, paper)
     lines += _plan_section(r)
-    lines += ["", "## Stages", "", f"| stage | lines | samples | coverage | model {obj} | simulated {obj} |",
-              "|---|---|---|---|---|---|"]
-    for st in r["stages"]:
-        lines.append(f"| {st['name']} | {st['n_lines']} | {st['n_samples']} | {st['coverage']:.0%} | "
-                     f"{st['predicted']:.6g} | {st['simulated']:.6g} |")
+    if r["stages"]:  # the line model's stages (the sparse method)
+        lines += ["", "## Stages", "", f"| stage | lines | samples | coverage | model {obj} | simulated {obj} |",
+                  "|---|---|---|---|---|---|"]
+        lines += [f"| {st['name']} | {st['n_lines']} | {st['n_samples']} | {st['coverage']:.0%} | "
+                  f"{st['predicted']:.6g} | {st['simulated']:.6g} |" for st in r["stages"]]
+    else:
+        lines += ["", "## The run"]
     lines += ["", r["message"], "", "## Timings", "", "| step | seconds |", "|---|---|"]
     lines += [f"| {k.removesuffix('_s')} | {t:.2f} |" for k, t in r["timings_s"].items()]
     lines += ["", "## Figures", ""]

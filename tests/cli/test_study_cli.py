@@ -56,6 +56,24 @@ def test_study_writes_result_report_and_figures(study_dir):
         elif rel.endswith(".gif"):
             assert path.read_bytes()[:6] in (b"GIF87a", b"GIF89a")
     assert (study_dir / "samples.sqlite").is_file() and (study_dir / "model.json").is_file()
+    # The progress figure's data: the objective of every simulation the method asked for, in order; its best is
+    # the optimum reported.
+    history = np.array(result["history"], dtype=float)
+    assert history.size == result["simulations"]["optimisation"]
+    assert np.nanmin(history) == pytest.approx(opt["objective"], rel=1e-12)
+    assert "figures/progress.png" in result["figures"].values()
+
+
+def test_a_study_without_constraints_or_lines(tmp_path):
+    # auto on a test function: no line-model stages in the report and no one-colour feasible-region figure; the
+    # progress figure and the run's message instead.
+    assert main(["study", "hartmann3", "--budget", "12", "--out", str(tmp_path), "--workers", "1",
+                 "--no-progress"]) == 0
+    result = json.loads((tmp_path / "result.json").read_text())
+    report = (tmp_path / "report.md").read_text()
+    assert "## Stages" not in report and "## The run" in report and result["message"] in report
+    assert list(result["figures"].values()) == ["figures/progress.png"]
+    assert _is_png(tmp_path / "figures" / "progress.png") and len(result["history"]) == 12
 
 
 def test_rerun_resumes_from_the_store(study_dir, tmp_path, capsys):
