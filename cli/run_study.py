@@ -130,11 +130,10 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
         t0 = time.perf_counter()
         result = run_method(problem, method, options, sampler, log)
         timings["optimise_s"] = time.perf_counter() - t0
-        # The objective of each simulation the method asked for, in order (NaN: failed): the progress figure.
-        result["history"] = [value for _, value in sampler.history.values()]
         n_opt = len(sampler.designs)
         timing = sampler.timing()
-        result.update(parallel_accounting(sampler))
+        # history: each simulation's objective in the order asked (NaN: failed), for the progress figure.
+        result.update(parallel_accounting(sampler), history=[value for _, value in sampler.history.values()])
         log(f"  {_optimised_line(result)}; {rounds_text(timing)}")
         validation = _validate(result, problem, options, sampler, timings, log)
         n_val = len(sampler.designs) - n_opt
