@@ -72,9 +72,10 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
                           "margins": margins, "outputs": outputs, "engine": problem.settings().get("engine")}))
     else:
         print(message)
-        engine = problem.settings().get("engine", "")
-        print(f"engine {engine}: " + ", ".join(f"{k} = {v:.6g}" for k, v in outputs.items()
-                                               if isinstance(v, float) and k in problem.outputs))
+        engine = problem.settings().get("engine")
+        values = ", ".join(f"{k} = {v:.6g}" for k, v in outputs.items()
+                           if isinstance(v, float) and k in problem.outputs)
+        print(f"{f'engine {engine}' if engine else 'simulated'}: {values}")
         if args.plot:
             print(f"figure written to {args.plot}")
     return 0 if feasible else EXIT_INFEASIBLE
@@ -87,5 +88,7 @@ def feasibility_message(problem, x: np.ndarray, margins: dict, feasible: bool) -
         head += " (outside the study's region)"
     failed = [f"{k} violated by {-v:.4g}" for k, v in margins.items() if not v >= 0]
     if feasible:
+        if not margins:
+            return f"{head}: feasible (the problem declares no constraints)"
         return f"{head}: feasible (margins: " + ", ".join(f"{k} {v:.4g}" for k, v in margins.items()) + ")"
     return f"{head}: infeasible — " + ("; ".join(failed) if failed else "outside the region")

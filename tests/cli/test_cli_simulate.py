@@ -15,6 +15,14 @@ def test_simulate_prints_feasibility_and_torques(capsys):
     assert "feasible" in out and "t_rms = 4.77" in out and "t_max = 8.06" in out
 
 
+def test_simulate_a_problem_without_constraints_or_engine(capsys):
+    # It printed "feasible (margins: )" and "engine : f = ...".
+    assert main(["simulate", "--study", "hartmann3", "--x1", "0.1", "--x2", "0.5", "--x3", "0.8"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].endswith("feasible (the problem declares no constraints)")
+    assert lines[1] == "simulated: f = -3.53704"  # Hartmann-3 at (0.1, 0.5, 0.8)
+
+
 def test_simulate_json_and_plot(capsys, tmp_path):
     png = tmp_path / "orig.png"
     assert main(["simulate", "--oa", "53", "--ab", "65", "--bc", "282", "--json", "--plot", str(png)]) == 0
