@@ -27,7 +27,7 @@ import numpy as np
 from scipy.optimize import OptimizeResult
 
 from mechopt.errors import InputError, MechoptError
-from mechopt.optimize.arguments import DEFAULT_METHOD, SPARSE_METHODS
+from mechopt.optimize.arguments import DEFAULT_METHOD, handles_dim
 from mechopt.optimize.baselines import BASELINES, LIBRARY_BASELINES
 from mechopt.optimize.budget import BudgetExhausted, CountedProblem
 from mechopt.optimize.ground_truth import GroundTruth
@@ -265,7 +265,7 @@ def check_methods(methods: list[str] | None, budgets: Iterable[int], gp_max_budg
             raise InputError(f"unknown method {unknown[0]!r}; expected some of {', '.join(names)}")
         names = [n for n in names if n in methods]
         for name in methods:
-            wrong = [d for d in dims if OUR_METHODS.get(name) in SPARSE_METHODS and not 2 <= d <= 4]
+            wrong = [d for d in dims if name in OUR_METHODS and not handles_dim(OUR_METHODS[name], d)]
             if wrong:
                 raise InputError(f"--methods {name}: method {OUR_METHODS[name]!r} handles 2 to 4 design variables, a "
                                  f"study compared has {wrong[0]}; use mechopt-auto or a baseline")
@@ -340,7 +340,7 @@ def compare(study: Study, truth: GroundTruth, budgets: list[int], seeds: int, me
     own = study.method or DEFAULT_METHOD
     if not methods:  # every method: ours once each, and the line models only where they apply (2 to 4 variables)
         names = [n for n in names if OUR_METHODS.get(n) != own
-                 and not (OUR_METHODS.get(n) in SPARSE_METHODS and not 2 <= problem.dim <= 4)]
+                 and (n not in OUR_METHODS or handles_dim(OUR_METHODS[n], problem.dim))]
     caps = method_caps(gp_max_budget, problem.dim)
     for name in names:
         skipped = [b for b in budgets if b > caps.get(name, b)]

@@ -40,10 +40,12 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
     if args.budget is not None:
         check_budget(args.budget)
     check_method(args.method, study.problem.dim, study.name)
-    # Checked on the options first, silently: a refused budget prints nothing but its one line.
-    options = study_options(study, overrides(args))
+    # The options' notes wait for the budget check: a refused budget prints nothing but its one line.
+    notes: list[str] = []
+    options = study_options(study, overrides(args), log=notes.append)
     check_method(args.method, study.problem.dim, study.name, options.budget, n_lines=options.n_lines)
-    options = study_options(study, overrides(args), log=print)
+    for note in notes:
+        print(note)
     out_arg = Path(args.out or f"{study.name}-study")
     if args.dry_run:
         store = Path(args.store) if args.store else out_arg / "samples.sqlite"

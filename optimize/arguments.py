@@ -11,7 +11,7 @@ import numpy as np
 from mechopt.errors import InputError
 
 __all__ = ["AUTO_METHOD", "MIN_BUDGET", "SPARSE_METHODS", "available_methods", "check_budget", "check_method",
-           "check_seed", "check_workers", "method_min_budget"]
+           "check_seed", "check_workers", "handles_dim", "method_min_budget"]
 
 #: The fewest simulations any method is given: a model needs a few designs before it can propose one.
 MIN_BUDGET = 3
@@ -84,7 +84,7 @@ def check_method(method: Any, dim: int, name: str = "the problem", budget: int |
         return
     if method not in available_methods():
         raise InputError(f"method = {method!r}; expected one of {', '.join(available_methods())} or a callable")
-    if method in SPARSE_METHODS and not 2 <= dim <= 4:
+    if not handles_dim(method, dim):
         raise InputError(f"method {method!r} handles 2 to 4 design variables; {name!r} has {dim}: choose 'auto' "
                          "or a baseline (`--method`, `mechopt methods`)")
     if budget is None:
@@ -93,6 +93,11 @@ def check_method(method: Any, dim: int, name: str = "the problem", budget: int |
     if budget < need:
         raise InputError(f"budget = {budget}: method {method!r} needs at least {why} = {need} simulations for the "
                          f"{dim} variables of {name!r}")
+
+
+def handles_dim(method: str, dim: int) -> bool:
+    """Whether a method takes ``dim`` design variables: the line models 2 to 4, every other method any number."""
+    return method not in SPARSE_METHODS or 2 <= dim <= 4
 
 
 def method_min_budget(method: str, dim: int, budget: int = MIN_BUDGET, n_lines: int | None = None) -> tuple[int, str]:
