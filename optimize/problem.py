@@ -34,11 +34,16 @@ import numpy as np
 
 from mechopt.errors import InputError
 from mechopt.runs.fingerprint import fingerprint
+from mechopt.runs.sample_record import KEY_DECIMALS
 
 __all__ = ["FITS", "DesignProblem", "Variable", "as_design_array"]
 
 #: What the sparse model fits along its lines: the objective itself, or its square (smoother for an RMS value).
 FITS = ("value", "square")
+
+
+#: Narrowest range of a variable, in its unit: a thousand steps of the sample store's resolution.
+MIN_SPAN = 10.0 ** (3 - KEY_DECIMALS)
 
 
 @dataclass(frozen=True)
@@ -72,6 +77,13 @@ class Variable:
                 raise InputError(f"variable {self.name}: {key} = {value!r} must be a finite number")
         if not self.lower < self.upper:
             raise InputError(f"variable {self.name}: bounds [{self.lower}, {self.upper}] must satisfy lower < upper")
+        span = self.upper - self.lower
+        if round(span, KEY_DECIMALS) < MIN_SPAN:
+            # The sample store tells designs apart to KEY_DECIMALS decimals: a narrower range would hold too few
+            # distinct designs, and a method's steps would land on designs it has already simulated.
+            raise InputError(f"variable {self.name}: bounds [{self.lower!r}, {self.upper!r}] span {span:.3g}, "
+                             f"expected at least {MIN_SPAN:g} {self.unit} (the sample store resolves "
+                             f"{10.0**-KEY_DECIMALS:g}): state the variable in a smaller unit")
         object.__setattr__(self, "lower", float(self.lower))
         object.__setattr__(self, "upper", float(self.upper))
 

@@ -158,3 +158,12 @@ def test_trust_report_says_whether_the_model_resolves_the_landscape():
     rough = mechopt.minimize(Hartmann3(), budget=150, method="sparse", seed=0)
     assert not rough.trust["resolved"] and rough.trust["lolo_median"] > 0.05
     assert "does not resolve" in rough.trust["verdict"] and "sparse-global" in rough.trust["verdict"]
+
+
+def test_a_variable_narrower_than_the_store_resolves_is_refused_in_one_line():
+    # The store keys designs to 9 decimals: a range of 1e-7 mm holds 100 keys per variable, and the default
+    # method's steps came back as designs already simulated (19 of a budget of 30 were new).
+    with pytest.raises(mechopt.InputError) as info:
+        mechopt.Variable("gap", 1.0, 1.0000001, "mm")
+    assert str(info.value).startswith("variable gap: bounds [1.0, 1.0000001] span 1e-07, expected at least 1e-06 mm")
+    assert mechopt.Variable("gap", 1.0, 1.000001, "mm").upper == 1.000001
