@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from mechopt.cli.arguments import int_list, positive_float, positive_int
-from mechopt.cli.study_arguments import load
+from mechopt.cli.study_arguments import load, study_name
 
 __all__ = ["add_parser", "run"]
 
@@ -16,8 +16,10 @@ __all__ = ["add_parser", "run"]
 def add_parser(sub, engines: tuple[str, ...]) -> None:
     """Add ``compare`` to the subcommands."""
     p = sub.add_parser("compare", help="mechopt against other optimizers at equal simulation budgets")
-    p.add_argument("--study", default="ventilator", help="study names or .toml paths, comma separated; also the "
-                   "multimodal test functions (`mechopt studies` lists them all)")
+    what = ("study names or .toml paths, comma separated; also the multimodal test functions (default ventilator; "
+            "`mechopt studies` lists them all)")
+    p.add_argument("name", nargs="?", metavar="STUDIES", help=what)
+    p.add_argument("--study", help="the same, as a flag")
     p.add_argument("--engine", choices=engines, help="simulation engine (default: the study's [compare] engine)")
     p.add_argument("--budgets", type=int_list, default=[50, 100, 200, 618, 1870],
                    help="simulation budgets, comma separated (default 50,100,200,618,1870)")
@@ -50,7 +52,7 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
     from mechopt.cli.run_study import check_output_folder
     from mechopt.optimize.ground_truth import load_or_compute
 
-    names = [n for n in args.study.split(",") if n]
+    names = [n for n in study_name(args).split(",") if n]
     methods = args.methods.split(",") if args.methods else None
     studies = _studies(args, names)
     cmp.check_methods(methods, args.budgets, args.gp_max_budget, [s.problem.dim for s in studies])

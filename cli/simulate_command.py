@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from mechopt.cli.arguments import Parser
-from mechopt.cli.study_arguments import add_study_argument, load
+from mechopt.cli.study_arguments import add_study_argument, load, study_name
 from mechopt.errors import InfeasibleDesignError, InputError
 
 __all__ = ["EXIT_INFEASIBLE", "add_parser", "feasibility_message"]
@@ -23,7 +23,10 @@ def add_parser(sub, engines: tuple[str, ...]) -> None:
     """Add ``simulate`` to the subcommands."""
     p = sub.add_parser("simulate", help="simulate one design: feasibility with margins and the outputs; the "
                        "variables are flags named after the study's (--oa 53 --ab 65 --bc 282 for a four-bar)")
-    add_study_argument(p, engines)
+    # The study as a first word is taken from the flags argparse leaves over: declared as a positional it would
+    # swallow the value of the first variable's flag (--oa 53 is not known to the parser).
+    add_study_argument(p, engines, word=False)
+    p.usage = "mechopt simulate [STUDY] [--study STUDY] [--engine ENGINE] [--json] [--plot FILE] --VARIABLE VALUE ..."
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--plot", metavar="FILE", help="write the mechanism's figure of the design to FILE (png)")
     p.set_defaults(func=run, extra=True)
@@ -31,7 +34,7 @@ def add_parser(sub, engines: tuple[str, ...]) -> None:
 
 def _design(problem, args: argparse.Namespace, rest: list[str]) -> np.ndarray:
     """The design given as one flag per variable (``--oa 53``), each a finite number."""
-    p = Parser(prog=f"mechopt simulate --study {args.study}")
+    p = Parser(prog=f"mechopt simulate {study_name(args)}")
     for v in problem.variables:
         p.add_argument(f"--{v.name}", type=float, required=True, help=f"{v.label or v.name} ({v.unit})")
     values = p.parse_args(rest)
@@ -44,6 +47,8 @@ def _design(problem, args: argparse.Namespace, rest: list[str]) -> np.ndarray:
 
 def run(args: argparse.Namespace, rest: list[str]) -> int:
     """Simulate the design; 0 if feasible, :data:`EXIT_INFEASIBLE` if not."""
+    if rest and not rest[0].startswith("-"):
+        args.name, rest = rest[0], rest[1:]
     problem = load(args).problem
     x = _design(problem, args, rest)
     if args.plot:

@@ -7,21 +7,35 @@ import argparse
 from typing import Any
 
 from mechopt.cli.arguments import count, positive_int
+from mechopt.errors import InputError
 
-__all__ = ["add_method_option", "add_run_options", "add_study_argument", "load", "overrides"]
+__all__ = ["add_method_option", "add_run_options", "add_study_argument", "load", "overrides", "study_name"]
+
+#: The study a command runs when none is named: the main job.
+DEFAULT_STUDY = "ventilator"
 
 
-def load(args: argparse.Namespace, name: str | None = None):
-    """The study named by ``name`` or ``--study``, with the ``--engine`` override."""
+def study_name(args: argparse.Namespace) -> str:
+    """The study named on the command line, first word or ``--study`` (both is an error unless they agree)."""
+    word, flag = getattr(args, "name", None), getattr(args, "study", None)
+    if word and flag and word != flag:
+        raise InputError(f"study named twice: {word!r} and --study {flag!r}; expected one of them")
+    return word or flag or DEFAULT_STUDY
+
+
+def load(args: argparse.Namespace):
+    """The study named on the command line, with the ``--engine`` override."""
     from mechopt.studies.catalogue import load_study
 
-    return load_study(name or args.study, {"engine": getattr(args, "engine", None)})
+    return load_study(study_name(args), {"engine": getattr(args, "engine", None)})
 
 
-def add_study_argument(p: argparse.ArgumentParser, engines: tuple[str, ...]) -> None:
-    """``--study`` and ``--engine``."""
-    p.add_argument("--study", default="ventilator", help="study name or path of a study .toml (default ventilator; "
-                   "`mechopt studies` lists them)")
+def add_study_argument(p: argparse.ArgumentParser, engines: tuple[str, ...], word: bool = True) -> None:
+    """The study, as the first word (``word``) or ``--study``, and ``--engine``."""
+    what = f"study name or path of a study .toml (default {DEFAULT_STUDY}; `mechopt studies` lists them)"
+    if word:
+        p.add_argument("name", nargs="?", metavar="STUDY", help=what)
+    p.add_argument("--study", help=what if not word else "the same, as a flag")
     p.add_argument("--engine", choices=engines, help="simulation engine (default: the study's)")
 
 

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from mechopt.cli.arguments import count, positive_float
-from mechopt.cli.study_arguments import add_method_option, add_run_options, load, overrides
+from mechopt.cli.study_arguments import add_method_option, add_run_options, add_study_argument, load, overrides
 
 __all__ = ["add_parser", "run"]
 
@@ -14,9 +14,7 @@ __all__ = ["add_parser", "run"]
 def add_parser(sub, engines: tuple[str, ...]) -> None:
     """Add ``study`` to the subcommands."""
     p = sub.add_parser("study", help="run a study: sample, fit, search, refine, validate, report")
-    p.add_argument("name", nargs="?", default="ventilator",
-                   help="study name or .toml path (default: ventilator; `mechopt studies` lists them)")
-    p.add_argument("--engine", choices=engines, help="simulation engine (default: the study's)")
+    add_study_argument(p, engines)
     add_method_option(p)
     add_run_options(p)
     p.add_argument("--lines", type=count, help="most held-out validation lines (default 10; 0: no validation)")
@@ -35,7 +33,7 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
     from mechopt.cli.run_study import check_output_folder, plan_study, run_study, study_options, summary_lines
     from mechopt.optimize.arguments import DEFAULT_METHOD, check_budget, check_method
 
-    study = load(args, args.name)
+    study = load(args)
     args.method = args.method or study.method or DEFAULT_METHOD
     if args.budget is not None:
         check_budget(args.budget)

@@ -104,3 +104,22 @@ def test_console_script_without_traceback():
     )
     assert proc.returncode == EXIT_ERROR
     assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
+
+
+def test_every_command_takes_the_study_as_its_first_word(capsys, tmp_path):
+    # `mechopt study hartmann3` worked, `mechopt validate hartmann3` was "unrecognized arguments": each command now
+    # takes the first word or --study, and one study named twice is an error unless both agree.
+    assert main(["simulate", "hartmann3", "--x1", "0.1", "--x2", "0.5", "--x3", "0.8"]) == 0
+    assert capsys.readouterr().out.splitlines()[1] == "simulated: f = -3.53704"
+    assert main(["simulate", "--json", "hartmann3", "--x1", "0.1", "--x2", "0.5", "--x3", "0.8"]) == 0
+    assert json.loads(capsys.readouterr().out)["outputs"]["f"] == pytest.approx(-3.53704, abs=1e-5)
+    assert main(["study", "--study", "hartmann3", "--dry-run", "--out", str(tmp_path / "a")]) == 0
+    assert "hartmann3" in capsys.readouterr().out
+    out = str(tmp_path / "b")
+    for command in (["study", "hartmann3", "--study", "branin", "--out", out],
+                    ["truth", "hartmann3", "--study", "branin", "--out", out],
+                    ["simulate", "hartmann3", "--study", "branin", "--x1", "0.1"]):
+        assert main(command) == EXIT_ERROR
+        err = capsys.readouterr().err
+        assert "study named twice: 'hartmann3' and --study 'branin'" in err and err.count("\n") == 1
+    assert not (tmp_path / "b").exists()
