@@ -19,7 +19,7 @@ import numpy as np
 
 from mechopt.cli.study_header import study_header
 from mechopt.cli.study_options import study_options
-from mechopt.cli.study_plan import RunPlan, duration_text, open_store_if_any, plan_run
+from mechopt.cli.study_plan import RunPlan, duration_text, open_store_if_any, plan_run, plan_validation
 from mechopt.errors import InputError
 from mechopt.optimize.arguments import check_method
 from mechopt.optimize.ground_truth import GroundTruth, load_or_compute
@@ -172,17 +172,33 @@ def plan_study(study: Study, options: SparseOptions, workers: int | None = None,
     designs it lacks) and never created.
     """
     check_method(method, study.problem.dim, study.name, options.budget, n_lines=options.n_lines)
-    if scheduler is not None:
-        with make_executor(workers=workers, scheduler=scheduler) as executor:  # only to count the cluster's workers
-            n_workers = executor.workers
-    else:
-        n_workers = workers or default_workers()
     store = open_store_if_any(store_path) if store_path is not None else None
     try:
-        return plan_run(study, options, method, store, n_workers, retry_failed)
+        return plan_run(study, options, method, store, _count_workers(workers, scheduler), retry_failed)
     finally:
         if store is not None:
             store.close()
+
+
+def plan_validate(study: Study, options: SparseOptions, model: Any = None, workers: int | None = None,
+                  scheduler: str | None = None, store_path: Path | None = None,
+                  retry_failed: bool = False) -> RunPlan:
+    """The plan of ``mechopt validate`` (the line model's lines when there is no saved ``model``, then the held-out
+    lines) without running it; ``store_path`` is read when it exists and never created."""
+    store = open_store_if_any(store_path) if store_path is not None else None
+    try:
+        return plan_validation(study, options, store, _count_workers(workers, scheduler), model, retry_failed)
+    finally:
+        if store is not None:
+            store.close()
+
+
+def _count_workers(workers: int | None, scheduler: str | None) -> int:
+    """Simulations a run will have at the same time: ``workers``, all cores, or the Dask cluster's workers."""
+    if scheduler is not None:
+        with make_executor(workers=workers, scheduler=scheduler) as executor:  # only to count the cluster's workers
+            return executor.workers
+    return workers or default_workers()
 
 
 def _optimised_line(result: OptimizeResult) -> str:

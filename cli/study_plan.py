@@ -23,7 +23,7 @@ from mechopt.runs.store import SampleStore, design_key
 from mechopt.studies.catalogue import Study
 
 __all__ = ["BATCH_METHODS", "PlanStage", "RunPlan", "duration_text", "open_store_if_any", "plan_run",
-           "seconds_per_run"]
+           "plan_validation", "seconds_per_run"]
 
 #: The methods that propose as many designs at once as there are workers (issue 28).
 BATCH_METHODS = ("sparse", "sparse-global", "auto")
@@ -92,6 +92,8 @@ class RunPlan:
         Seconds a simulation (None: unknown).
     cost_source : str
         Where ``per_run`` comes from.
+    headline : str, optional
+        The plan's first line, when it is not a budget to optimise (``mechopt validate``); the workers follow it.
     """
 
     stages: list[PlanStage]
@@ -100,6 +102,7 @@ class RunPlan:
     workers: int
     per_run: float | None
     cost_source: str
+    headline: str | None = None
 
     @property
     def total(self) -> int:
@@ -125,9 +128,12 @@ class RunPlan:
 
     def text(self) -> list[str]:
         """The plan as printed before the run."""
-        share = (f"{self.validation} held-out simulations on top of it ({self.validation / self.budget:.0%})"
-                 if self.validation else "no held-out validation")
-        lines = [f"plan: budget {self.budget} simulations to optimise, {share}; {self.workers} at a time"]
+        head = self.headline
+        if head is None:
+            share = (f"{self.validation} held-out simulations on top of it ({self.validation / self.budget:.0%})"
+                     if self.validation else "no held-out validation")
+            head = f"plan: budget {self.budget} simulations to optimise, {share}"
+        lines = [f"{head}; {self.workers} at a time"]
         for s in self.stages:
             count = f"{s.simulations}" if s.exact else f"up to {s.simulations}"
             held = f", {s.held} already in the store" if s.held else ""
@@ -216,12 +222,8 @@ def plan_run(study: Study, options: SparseOptions, method: str, store: SampleSto
     budget = int(options.budget)
     stages: list[PlanStage] = []
     if method == "sparse":
-        plan, _, designs = planned_designs(ModelSpace(problem), options, options.n_lines, options.samples_per_line,
-                                           options.plan == "paper", options.line_cap())
-        on_lines = np.vstack(designs)
-        n_lines = len({design_key(tuple(map(float, d))) for d in on_lines})
-        stages.append(PlanStage(f"global model: {plan.n_lines} lines", n_lines,
-                                _held(store, on_lines, fingerprint, retry_failed)))
+        stages.append(_line_stage(study, options, store, retry_failed))
+        n_lines = stages[-1].simulations
         stages.append(PlanStage("confirm the model's candidate", 1))
         if options.refine and budget - n_lines - 1 > 0:
             stages.extend(_refinement(budget - n_lines - 1, workers, problem.dim))
@@ -239,6 +241,40 @@ def plan_run(study: Study, options: SparseOptions, method: str, store: SampleSto
                                 _held(store, np.vstack(list(references.values())), fingerprint, retry_failed)))
     per_run, source = seconds_per_run(study, store)
     return RunPlan(stages, budget, validation, workers, per_run, source)
+
+
+def _line_stage(study: Study, options: SparseOptions, store: SampleStore | None, retry_failed: bool) -> PlanStage:
+    """The lines of the global model: their distinct designs, and how many of them the store holds."""
+    plan, _, designs = planned_designs(ModelSpace(study.problem), options, options.n_lines, options.samples_per_line,
+                                       options.plan == "paper", options.line_cap())
+    on_lines = np.vstack(designs)
+    n = len({design_key(tuple(map(float, d))) for d in on_lines})
+    return PlanStage(f"global model: {plan.n_lines} lines", n,
+                     _held(store, on_lines, study.problem.fingerprint(), retry_failed))
+
+
+def plan_validation(study: Study, options: SparseOptions, store: SampleStore | None, workers: int, model=None,
+                    retry_failed: bool = False) -> RunPlan:
+    """The plan of ``mechopt validate``: the line model's lines when there is no saved ``model``, then the held-out
+    lines.  With a saved model they are placed here as the run will place them (seeded, no simulation), and the store
+    is asked which it holds; a model still to be fitted places them later, so ``validation_lines`` of
+    ``validation_points`` is then an upper bound."""
+    from mechopt.optimize.sparse.validate import validation_lines
+
+    lines, points = options.validation_lines, options.validation_points
+    if model is None:
+        stages = [_line_stage(study, options, store, retry_failed),
+                  PlanStage(f"validate: {lines} held-out lines of {points}", lines * points, exact=False)]
+        headline = f"plan: a line model of {stages[0].simulations} simulations, then up to {lines * points} held-out"
+    else:
+        placed = validation_lines(model, ModelSpace(study.problem), lines, points, options.seed)
+        designs = np.vstack(placed) if placed else np.zeros((0, study.problem.dim))
+        n = len({design_key(tuple(map(float, d))) for d in designs})
+        stages = [PlanStage(f"validate the saved line model: {len(placed)} held-out lines of {points}", n,
+                            _held(store, designs, study.problem.fingerprint(), retry_failed))]
+        headline = f"plan: the saved line model, {n} held-out simulations"
+    per_run, source = seconds_per_run(study, store)
+    return RunPlan(stages, 0, stages[-1].simulations, workers, per_run, source, headline=headline)
 
 
 def _refinement(left: int, workers: int, dim: int) -> list[PlanStage]:

@@ -96,9 +96,18 @@ def test_rerun_resumes_from_the_store(study_dir, tmp_path, capsys):
 
 
 def test_validate_reuses_the_model(study_dir, capsys):
-    assert main(["validate", "--out", str(study_dir), "--lines", "2", *SMALL]) == 0
+    # Its plan first, exact with a saved model: the held-out lines are placed without simulating, and the store
+    # holds the 6 lines of 8 the study validated on (the same seed places the same lines first).
+    assert main(["validate", "--out", str(study_dir), "--lines", "7", "--dry-run", *SMALL]) == 0
+    plan = capsys.readouterr().out.splitlines()
+    assert plan[0] == "plan: the saved line model, 56 held-out simulations; 1 at a time"
+    assert plan[1].startswith("  validate the saved line model: 7 held-out lines of 8: 56 simulations, 48 already in "
+                              "the store")
+    assert plan[-1] == "dry run: nothing simulated"
+    assert main(["validate", "--out", str(study_dir), "--lines", "7", *SMALL]) == 0
     out = capsys.readouterr().out
-    assert "model read from" in out and "held-out simulations on 2 lines" in out
+    assert "model read from" in out and "held-out simulations on 7 lines" in out
+    assert out.splitlines()[-1] == "simulations: 8 new, 48 reused from the store, 0 computed by another run"
     # Its own figure: the study's validation figure is not overwritten.
     assert _is_png(study_dir / "figures" / "validation_heldout.png") and _is_png(study_dir / "figures" /
                                                                                   "validation.png")
