@@ -85,11 +85,17 @@ def run_methods(args: argparse.Namespace, rest: list[str]) -> int:
 
 def run_init(args: argparse.Namespace, rest: list[str]) -> int:
     """Copy a packaged study's files into a new folder."""
-    from mechopt.studies.catalogue import STUDIES_DIR, available_studies
+    from mechopt.studies.catalogue import STUDIES_DIR
+    from mechopt.studies.test_functions import SUITE
 
+    files = sorted(p.parent.name.replace("_", "-") for p in STUDIES_DIR.glob("*/study.toml"))
+    if args.name in SUITE:
+        # A test function is a class, not a file: there is nothing to copy, and the list below must not name it.
+        raise InputError(f"{args.name!r} is a test function (a Python class), not a study file to copy; expected one "
+                         f"of {', '.join(files)}, or define a mechopt.DesignProblem (README: Define your own problem)")
     folder = STUDIES_DIR / args.name.replace("-", "_")
-    if not (folder / "study.toml").is_file():
-        raise InputError(f"unknown study {args.name!r}; expected one of {', '.join(available_studies())}")
+    if args.name.replace("_", "-") not in files or not (folder / "study.toml").is_file():
+        raise InputError(f"unknown study {args.name!r}; expected one of {', '.join(files)}")
     to = Path(args.to or f"my-{args.name}")
     if to.exists() and (not to.is_dir() or any(to.iterdir())):
         raise InputError(f"{to} exists and is not an empty folder; name another with --to")

@@ -83,3 +83,22 @@ def test_test_function_descriptions_are_whole_sentences_without_markup():
         assert load_study(name).description == text
     assert SUITE["failing_hartmann3"].summary().endswith("returns NaN where x2 > 0.9 (the global minimum lies where it "
                                                           "succeeds)")
+
+
+def test_init_copies_a_study_that_then_runs_and_refuses_what_it_cannot_copy(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(["init", "rowing"]) == 0
+    assert sorted(p.name for p in (tmp_path / "my-rowing").iterdir()) == ["README.md", "desired_effort.csv",
+                                                                           "study.toml"]
+    capsys.readouterr()
+    assert main(["study", "my-rowing/study.toml", "--dry-run"]) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == "dry run: nothing simulated"
+    assert main(["init", "rowing"]) == EXIT_ERROR  # the folder is not empty: nothing is overwritten
+    assert "my-rowing exists and is not an empty folder" in capsys.readouterr().err
+    # It listed hartmann3 among the studies it could not find.
+    assert main(["init", "hartmann3"]) == EXIT_ERROR
+    err = capsys.readouterr().err
+    assert "'hartmann3' is a test function (a Python class), not a study file to copy" in err
+    assert "hartmann3," not in err and err.count("\n") == 1
+    assert main(["init", "../rowing"]) == EXIT_ERROR
+    assert "unknown study '../rowing'; expected one of" in capsys.readouterr().err
