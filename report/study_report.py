@@ -53,6 +53,30 @@ def _jsonable(value: Any) -> Any:
     raise TypeError(f"{type(value).__name__} is not JSON-serializable")
 
 
+def _design_table(r: dict[str, Any], problem, names: list[str], units: dict[str, str]) -> list[str]:
+    """The designs' table: variables, outputs, savings against the original design (when the study has one) and the
+    paper's own figures."""
+    obj = problem.objective
+    outputs = list(problem.outputs)
+    papers = sorted({k for row in r["designs"] for k in row["paper"]})
+    savings = any("savings_pct" in row for row in r["designs"])
+    lines = ["| design | " + " | ".join(f"{n} ({units[n]})" if units[n] else n for n in names) + " | "
+             + " | ".join(problem.output_label(k) for k in outputs) + (f" | {obj} savings" if savings else "")
+             + " | " + "".join(f"{k} | " for k in papers) + "feasible |",
+             "|---" * (len(names) + len(outputs) + len(papers) + 2 + savings) + "|"]
+    for row in r["designs"]:
+        values = [(_fmt(row["outputs"].get(k)) if row["status"] == "ok" else row["status"]) for k in outputs]
+        saved = (f"{row['savings_pct']:.1f} %" if "savings_pct" in row else "—") + " | " if savings else ""
+        lines.append(f"| {row['name']} | " + " | ".join(f"{row['design'][n]:.4f}" for n in names) + " | "
+                     + " | ".join(values) + " | " + saved
+                     + "".join(f"{_fmt(row['paper'].get(k))} | " for k in papers)
+                     + f"{'yes' if row['feasible'] else 'no'} |")
+    if papers:
+        lines += ["", "The paper_* columns are the paper's own figures for the same designs (its model, not ours)"
+                  + (": compare savings, not absolute values, where the models differ." if savings else ".")]
+    return lines
+
+
 def result_dict(run) -> dict[str, Any]:
     """The machine-readable summary of a run (``result.json``)."""
     study, res, problem = run.study, run.result, run.study.problem
@@ -195,22 +219,7 @@ def report_markdown(r: dict[str, Any], study) -> str:
              + ("" if o["predicted"] is None else f" (model {o['predicted']:.6g})") + ".", "",
              _simulations_sentence(r), "",
              "## Designs", ""]
-    outputs = list(problem.outputs)
-    papers = sorted({k for row in r["designs"] for k in row["paper"]})
-    lines += ["| design | " + " | ".join(f"{n} ({units[n]})" if units[n] else n for n in names) + " | "
-              + " | ".join(problem.output_label(k) for k in outputs) + f" | {obj} savings | "
-              + "".join(f"{k} | " for k in papers) + "feasible |",
-              "|---" * (len(names) + len(outputs) + len(papers) + 3) + "|"]
-    for row in r["designs"]:
-        values = [(_fmt(row["outputs"].get(k)) if row["status"] == "ok" else row["status"]) for k in outputs]
-        lines.append(f"| {row['name']} | " + " | ".join(f"{row['design'][n]:.4f}" for n in names) + " | "
-                     + " | ".join(values) + " | "
-                     + (f"{row['savings_pct']:.1f} %" if "savings_pct" in row else "—") + " | "
-                     + "".join(f"{_fmt(row['paper'].get(k))} | " for k in papers)
-                     + f"{'yes' if row['feasible'] else 'no'} |")
-    if papers:
-        lines += ["", "The paper_* columns are the paper's own figures for the same designs (its model, not ours): "
-                  "compare savings, not absolute values, where the models differ."]
+    lines += _design_table(r, problem, names, units)
     if r["failures"]:
         lines += ["", f"## Failed simulations ({len(r['failures'])})", "", "| design | error |", "|---|---|"]
         lines += [f"| {problem.describe(np.array([f['design'][n] for n in names]))} | {f['error']} |"

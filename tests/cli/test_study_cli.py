@@ -42,6 +42,7 @@ def test_study_writes_result_report_and_figures(study_dir):
     assert sims["new"] + sims["reused"] == sims["distinct_designs"] and sims["executor"]
     report = (study_dir / "report.md").read_text()
     assert "| original |" in report and "paper_global_optimum" in report and "reused from the store" in report
+    assert "| t_rms savings |" in report and "| 63." in report  # against the original design
     # The trust report: its measures and its verdict, in result.json and in the report.
     trust = result["trust"]
     assert trust["verdict"] and trust["verdict"] in report
@@ -72,6 +73,8 @@ def test_a_study_without_constraints_or_lines(tmp_path):
     result = json.loads((tmp_path / "result.json").read_text())
     report = (tmp_path / "report.md").read_text()
     assert "## Stages" not in report and "## The run" in report and result["message"] in report
+    # No original design, no column of dashes for savings against it.
+    assert "| design | x1 | x2 | x3 | f | feasible |" in report and "savings" not in report
     assert list(result["figures"].values()) == ["figures/progress.png"]
     assert _is_png(tmp_path / "figures" / "progress.png") and len(result["history"]) == 12
 
