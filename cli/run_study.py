@@ -118,6 +118,7 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
 
     problem = study.problem
     check_method(method, problem.dim, study.name, options.budget, n_lines=options.n_lines)
+    problem.check_region()
     out = check_output_folder(out)
     store_path = Path(store_path) if store_path else out / "samples.sqlite"
     timings: dict[str, float] = {}
@@ -172,6 +173,7 @@ def plan_study(study: Study, options: SparseOptions, workers: int | None = None,
     designs it lacks) and never created.
     """
     check_method(method, study.problem.dim, study.name, options.budget, n_lines=options.n_lines)
+    study.problem.check_region()
     store = open_store_if_any(store_path) if store_path is not None else None
     try:
         return plan_run(study, options, method, store, _count_workers(workers, scheduler), retry_failed)

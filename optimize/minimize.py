@@ -59,6 +59,7 @@ def _check_arguments(problem: Any, budget: Any, method: Any, seed: Any, workers:
     check_workers(workers)
     if store is not None and not isinstance(store, str | os.PathLike | SampleStore):
         raise InputError(f"store = {store!r}: expected the path of an SQLite file or a SampleStore")
+    problem.check_region()
 
 
 def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[..., Any] = DEFAULT_METHOD,

@@ -32,7 +32,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from mechopt.errors import InputError
+from mechopt.errors import InputError, MechoptError
 from mechopt.runs.fingerprint import fingerprint
 from mechopt.runs.sample_record import KEY_DECIMALS
 
@@ -41,6 +41,9 @@ __all__ = ["FITS", "DesignProblem", "Variable", "as_design_array"]
 #: What the sparse model fits along its lines: the objective itself, or its square (smoother for an RMS value).
 FITS = ("value", "square")
 
+
+#: Designs :meth:`DesignProblem.check_region` spreads over the box to find a feasible one.
+REGION_PROBES = 2**14
 
 #: Narrowest range of a variable, in its unit: a thousand steps of the sample store's resolution.
 MIN_SPAN = 10.0 ** (3 - KEY_DECIMALS)
@@ -290,13 +293,36 @@ class DesignProblem:
     def constraint_margins(self, X: Any) -> np.ndarray:
         """:meth:`margins` with its input and output checked: (n, len(constraints)), NaN read as violated."""
         X = as_design_array(X, self.dim)
-        M = np.asarray(self.margins(X), dtype=float)
+        try:
+            M = np.asarray(self.margins(X), dtype=float)
+        except MechoptError:
+            raise
+        except Exception as exc:  # the user's code: one line naming it, not a traceback from inside a method
+            raise InputError(f"{self.name}: margins raised {type(exc).__name__}: {exc}") from None
         if M.ndim == 1 and len(self.constraints) == 1:
             M = M[:, None]
         if M.shape != (X.shape[0], len(self.constraints)):
             raise InputError(f"{self.name}: margins returned shape {M.shape}, expected "
                              f"({X.shape[0]}, {len(self.constraints)}) for constraints {list(self.constraints)}")
         return np.where(np.isnan(M), -np.inf, M)
+
+    def check_region(self, n: int = REGION_PROBES) -> None:
+        """Raise a one-line :class:`InputError` if no design of ``n`` spread over the box (a scrambled Sobol set,
+        fixed seed) satisfies the declared constraints: no method can start, and each would fail its own way."""
+        if not self.constraints:
+            return
+        from scipy.stats import qmc
+
+        b = self.bounds
+        X = b[:, 0] + qmc.Sobol(self.dim, seed=0).random(n) * (b[:, 1] - b[:, 0])
+        M = self.constraint_margins(X)
+        if np.all(M >= 0.0, axis=1).any():
+            return
+        best = ", ".join(f"{c} {m:.3g}" if np.isfinite(m) else f"{c} NaN everywhere"
+                         for c, m in zip(self.constraints, M.max(axis=0), strict=True))
+        raise InputError(f"problem {self.name!r}: none of {n} designs spread over the box satisfies the declared "
+                         f"constraints (largest margins: {best}); expected some design with every margin >= 0: "
+                         "check the bounds and the margins' signs")
 
     def feasible(self, X: Any, margins: np.ndarray | None = None) -> np.ndarray:
         """Designs (n, d) inside the bounds and satisfying every constraint.
@@ -365,6 +391,10 @@ class DesignProblem:
             raise InputError(f"{where}: variables must be a non-empty tuple of mechopt.Variable")
         if len(set(self.names)) != len(self.names):
             raise InputError(f"{where}: variable names {list(self.names)} are not distinct")
+        for key in ("outputs", "constraints"):
+            names = getattr(self, key)
+            if isinstance(names, str) or not all(isinstance(n, str) for n in names):
+                raise InputError(f"{where}: {key} = {names!r}; expected a tuple of names such as ('f',)")
         if not self.outputs or self.objective not in self.outputs:
             raise InputError(f"{where}: objective {self.objective!r} must be one of outputs {list(self.outputs)}")
         if not isinstance(self.residuals, str) or (self.residuals and not self.residuals.isidentifier()):

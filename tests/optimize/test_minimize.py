@@ -167,3 +167,39 @@ def test_a_variable_narrower_than_the_store_resolves_is_refused_in_one_line():
         mechopt.Variable("gap", 1.0, 1.0000001, "mm")
     assert str(info.value).startswith("variable gap: bounds [1.0, 1.0000001] span 1e-07, expected at least 1e-06 mm")
     assert mechopt.Variable("gap", 1.0, 1.000001, "mm").upper == 1.000001
+
+
+class _Nowhere(Bracket):
+    """The disc moved out of the box: no design satisfies the constraint."""
+
+    def margins(self, X):
+        return (1.5**2 - (X[:, 0] - 9.0) ** 2 - X[:, 1] ** 2)[:, None]
+
+    def evaluate(self, x):
+        raise AssertionError("nothing may be simulated")
+
+
+class _Raises(Bracket):
+    def margins(self, X):
+        return {}["disc_mm2"]
+
+
+@pytest.mark.parametrize("method", ["auto", "sparse", "sparse-global", "slsqp", "optuna_tpe"])
+def test_an_empty_feasible_region_or_a_raising_margin_is_one_line_before_any_simulation(method):
+    # auto crashed in numpy ("zero-size array to reduction operation fmax"), sparse raised its own SurrogateError,
+    # the others simulated nothing and returned NaN: each failed its own way.
+    with pytest.raises(mechopt.InputError) as info:  # the largest margin: 1.5² − (2 − 9)² at the corner (2, 0)
+        mechopt.minimize(_Nowhere(), budget=30, method=method)
+    assert str(info.value) == ("problem 'bracket': none of 16384 designs spread over the box satisfies the declared "
+                               "constraints (largest margins: disc_mm2 -46.8); expected some design with every margin "
+                               ">= 0: check the bounds and the margins' signs")
+    with pytest.raises(mechopt.InputError, match=r"^bracket: margins raised KeyError: 'disc_mm2'$"):
+        mechopt.minimize(_Raises(), budget=30, method=method)
+
+
+def test_names_given_as_one_string_are_refused():
+    class Strings(Bracket):
+        outputs = "f"
+
+    with pytest.raises(mechopt.InputError, match=r"outputs = 'f'; expected a tuple of names such as \('f',\)"):
+        mechopt.minimize(Strings(), budget=30)
