@@ -63,6 +63,15 @@ UNFINISHED_MARK = "†"
 #: the default of :func:`mechopt.minimize`).
 OUR_METHODS = {"mechopt-auto": "auto", "mechopt-sparse": "sparse", "mechopt-global": "sparse-global"}
 
+
+def method_names(text: str | None) -> list[str] | None:
+    """``--methods``, comma separated, with mechopt's own methods also by the names ``--method`` and
+    :func:`mechopt.minimize` know them (``auto`` is ``mechopt-auto``); None: all."""
+    if not text:
+        return None
+    by_method = {method: name for name, method in OUR_METHODS.items()}
+    return [by_method.get(n, n) for n in text.split(",") if n]
+
 def true_objective(problem: DesignProblem, design: np.ndarray | None) -> float:
     """The objective of a returned design as the score sees it: NaN unless feasible."""
     if design is None or not np.all(np.isfinite(design)) or not problem.feasible(design)[0]:

@@ -24,7 +24,8 @@ def add_parser(sub, engines: tuple[str, ...]) -> None:
     p.add_argument("--budgets", type=int_list, default=[50, 100, 200, 618, 1870],
                    help="simulation budgets, comma separated (default 50,100,200,618,1870)")
     p.add_argument("--seeds", type=positive_int, default=5, help="seeds per method and budget (default 5)")
-    p.add_argument("--methods", help="comma-separated subset of the methods (default: all; `mechopt methods`)")
+    p.add_argument("--methods", help="comma-separated subset of the methods (default: all; `mechopt methods`; "
+                   "auto, sparse and sparse-global are mechopt-auto, mechopt-sparse and mechopt-global)")
     p.add_argument("--out", metavar="DIR", help="output folder (default: STUDY-study)")
     p.add_argument("--truth-grid", type=positive_float, default=1.0, help="grid of the ground truth brute force")
     p.add_argument("--gp-max-budget", type=positive_int, metavar="N",
@@ -53,7 +54,7 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
     from mechopt.optimize.ground_truth import load_or_compute
 
     names = [n for n in study_name(args).split(",") if n]
-    methods = args.methods.split(",") if args.methods else None
+    methods = cmp.method_names(args.methods)
     studies = _studies(args, names)
     cmp.check_methods(methods, args.budgets, args.gp_max_budget, [s.problem.dim for s in studies])
     base = Path(args.out or (f"{names[0]}-study" if len(names) == 1 else "compare"))

@@ -192,3 +192,13 @@ def test_a_run_refused_for_its_budget_is_marked_with_the_reason():
     assert refused.reason.startswith("refused: InputError: budget = 10") and "= 11 simulations" in refused.reason
     ran = run_one(problem, truth, "mechopt-sparse", 11, 0)
     assert ran.finished and 0 < ran.nfev <= 11
+
+
+def test_methods_by_the_names_study_and_minimize_give_them():
+    # `mechopt study --method auto` and then `mechopt compare --methods auto` was "unknown method 'auto'".
+    from mechopt.cli.compare import check_methods, method_names
+
+    assert method_names("auto,sparse,sparse-global,smt_ego") == ["mechopt-auto", "mechopt-sparse", "mechopt-global",
+                                                                 "smt_ego"]
+    assert method_names(None) is None and method_names("mechopt,") == ["mechopt"]
+    assert check_methods(method_names("auto,smt_ego"), [30], dims=[3]) == ["mechopt-auto", "smt_ego"]
