@@ -117,8 +117,7 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
     from mechopt.report.study_report import write_outputs
 
     problem = study.problem
-    check_method(method, problem.dim, study.name, options.budget, n_lines=options.n_lines)
-    problem.check_region()
+    _check(study, options, method)
     out = check_output_folder(out)
     store_path = Path(store_path) if store_path else out / "samples.sqlite"
     timings: dict[str, float] = {}
@@ -172,14 +171,19 @@ def plan_study(study: Study, options: SparseOptions, workers: int | None = None,
     Parameters are those of :func:`run_study`; ``store_path`` is read when it exists (a resumed run costs only the
     designs it lacks) and never created.
     """
-    check_method(method, study.problem.dim, study.name, options.budget, n_lines=options.n_lines)
-    study.problem.check_region()
+    _check(study, options, method)
     store = open_store_if_any(store_path) if store_path is not None else None
     try:
         return plan_run(study, options, method, store, _count_workers(workers, scheduler), retry_failed)
     finally:
         if store is not None:
             store.close()
+
+
+def _check(study: Study, options: SparseOptions, method: str) -> None:
+    """What :func:`mechopt.minimize` checks before any work: the method for this budget, a feasible region."""
+    check_method(method, study.problem.dim, study.name, options.budget, n_lines=options.n_lines)
+    study.problem.check_region()
 
 
 def plan_validate(study: Study, options: SparseOptions, model: Any = None, workers: int | None = None,
