@@ -19,7 +19,7 @@ from mechopt.optimize.auto.acquisition import propose_batch, thompson_batch
 from mechopt.optimize.auto.feasibility import SuccessModel
 from mechopt.optimize.auto.gp import GaussianProcess, fit_gp
 from mechopt.optimize.auto.least_squares_plan import least_squares_plan
-from mechopt.optimize.auto.plan import Plan, choose_plan
+from mechopt.optimize.auto.plan import GLOBAL_MAX_POINTS, Plan, choose_plan
 from mechopt.optimize.auto.polish import polish_on_constraints
 from mechopt.optimize.auto.transform import standardise
 from mechopt.optimize.auto.trust_region import TrustRegion
@@ -223,6 +223,11 @@ def _global_plan(run: _Run, plan: Plan) -> None:
     ones, zeros = np.ones(d), np.zeros(d)
     probed = False
     while run.remaining > 0:
+        if run.values.size >= GLOBAL_MAX_POINTS and run.remaining > plan.n_polish:
+            # The global GP's fit grows as n³: a large budget goes on with local models (plan.GLOBAL_MAX_POINTS).
+            run.prior, run.theta = True, None
+            _trust_region_plan(run, plan)
+            return
         k = min(plan.batch, run.remaining)
         gp, best = run.fit()
         centre = run.U[run.best_index()]

@@ -43,6 +43,27 @@ def test_plan_follows_dimension_and_budget():
     assert short.n_init <= 14 - 3 and choose_plan(6, 300).n_init == 14
 
 
+def test_a_budget_beyond_the_global_gps_size_goes_on_in_a_trust_region(monkeypatch):
+    # The global GP's fit grows as n³ (branin at 600: 130 s of the method's own time before, 73 s after): beyond
+    # plan.GLOBAL_MAX_POINTS designs the trust-region plan takes over.  Here the size is 14 so the handover happens
+    # within a test's budget; the closed-form minimum must still be found and the budget spent exactly.
+    import mechopt.optimize.auto.search as search
+
+    monkeypatch.setattr(search, "GLOBAL_MAX_POINTS", 14)
+    calls = []
+    real = search._trust_region_plan
+    monkeypatch.setattr(search, "_trust_region_plan",
+                        lambda run, plan: calls.append(run.values.size) or real(run, plan))
+    p = Quadratic()
+    r = auto_search(lambda X: np.array([p.evaluate(x)["f"] for x in np.atleast_2d(X)]),
+                    np.array(p.bounds, dtype=float), 40, seed=3)
+    assert calls == [14] and r.nfev == 40 == len(np.unique(r.X, axis=0))
+    np.testing.assert_allclose(r.x, p.centre, atol=0.03)
+    assert r.fun == pytest.approx(2.0, abs=2e-3)
+    assert "one global GP, expected improvement up to 300 designs, then a restarted trust region" in choose_plan(
+        3, 600).describe(3, 600)
+
+
 def test_hartmann3_global_basin_at_30():
     p = Hartmann3()
     r = minimize(p, 30, method="auto", seed=0)
