@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import argparse
+import re
 import shutil
 import tomllib
 from pathlib import Path
@@ -83,6 +84,23 @@ def run_methods(args: argparse.Namespace, rest: list[str]) -> int:
     return 0
 
 
+def _copy_shared_data(folder: Path, to: Path) -> list[str]:
+    """Copy the data files the study names in another packaged study (``"../ventilator/table.csv"``) beside the copy
+    and name them there: a renamed copy (as the user is told to make) no longer finds the packaged study's folder."""
+    toml = to / "study.toml"
+    text = toml.read_text()
+    copied = []
+    for name in sorted(set(re.findall(r'"(\.\./[^"]+)"', text))):
+        source = (folder / name).resolve()
+        if source.is_file() and not (to / source.name).exists():
+            shutil.copy2(source, to / source.name)
+            copied.append(source.name)
+        if (to / source.name).is_file():
+            text = text.replace(f'"{name}"', f'"{source.name}"')
+    toml.write_text(text)
+    return copied
+
+
 def run_init(args: argparse.Namespace, rest: list[str]) -> int:
     """Copy a packaged study's files into a new folder."""
     from mechopt.studies.catalogue import STUDIES_DIR
@@ -106,6 +124,7 @@ def run_init(args: argparse.Namespace, rest: list[str]) -> int:
             if f.is_file() and f.suffix in (".toml", ".csv", ".md", ".json", ".py") and f.name != "__init__.py":
                 shutil.copy2(f, to / f.name)
                 copied.append(f.name)
+        copied += _copy_shared_data(folder, to)
     except OSError as exc:
         raise InputError(f"cannot copy the study into {to}: {exc.strerror or exc}") from None
     print(f"copied {', '.join(copied)} to {to}; edit {to / 'study.toml'} (give it a new name) and run "

@@ -20,7 +20,7 @@ import numpy as np
 from mechopt.cli.study_header import study_header
 from mechopt.cli.study_options import study_options
 from mechopt.cli.study_plan import RunPlan, duration_text, open_store_if_any, plan_run, plan_validation
-from mechopt.errors import InputError
+from mechopt.errors import InputError, MechoptError
 from mechopt.optimize.arguments import check_method
 from mechopt.optimize.ground_truth import GroundTruth, load_or_compute
 from mechopt.optimize.minimize import parallel_accounting, run_method
@@ -135,6 +135,7 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
         # history: each simulation's objective in the order asked (NaN: failed), for the progress figure.
         result.update(parallel_accounting(sampler), history=[value for _, value in sampler.history.values()])
         log(f"  {_optimised_line(result)}; {rounds_text(timing)}")
+        _check_some_succeeded(study, result, sampler, store_path)
         validation = _validate(result, problem, options, sampler, timings, log)
         n_val = len(sampler.designs) - n_opt
         if result.model is not None:
@@ -148,12 +149,13 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
                     "references": len(sampler.designs) - n_opt - n_val, "optimisation_timing": timing}
         failures = [(np.array(d), e) for d, e in sampler.failures.values()]
     ground = _ground_truth(problem, out, truth, truth_step, timings)
-    if result.method == "sparse":
+    lines = result.get("pipeline") is not None  # False for a sparse run whose failures handed it to auto
+    if lines:
         result["trust"] = study_trust(result.stages[0], result.pipeline.best, validation)
     if result.get("trust"):
         log(f"  trust: {result.trust['verdict']}")
     result.update(validation=validation, outputs=references["optimum"]["outputs"])
-    if result.method == "sparse":
+    if lines:
         result["nfev"] = n_opt  # the pipeline's designs, confirmation and refinement included
     timings["total_s"] = time.perf_counter() - t_all
     run = StudyRun(study, options, result, validation, references, ground, timings, out, store_path, sampling,
@@ -178,6 +180,16 @@ def plan_study(study: Study, options: SparseOptions, workers: int | None = None,
     finally:
         if store is not None:
             store.close()
+
+
+def _check_some_succeeded(study: Study, result: OptimizeResult, sampler: Sampler, store_path: Path) -> None:
+    """One line instead of a report of no design when every simulation failed (a broken command, a missing
+    licence): the first reason, and where the failures are kept."""
+    if np.all(np.isfinite(np.asarray(result.x, dtype=float))):
+        return
+    first = next(iter(sampler.failures.values()), (None, "no design was simulated"))[1]
+    raise MechoptError(f"{study.name}: none of the {len(sampler.designs)} simulations succeeded, the first failed "
+                       f"with: {first}; they are recorded in {store_path} (--retry-failed simulates them again)")
 
 
 def _check(study: Study, options: SparseOptions, method: str) -> None:
@@ -208,7 +220,7 @@ def _count_workers(workers: int | None, scheduler: str | None) -> int:
 
 
 def _optimised_line(result: OptimizeResult) -> str:
-    if result.method == "sparse":
+    if result.get("pipeline") is not None:
         pipeline = result.pipeline
         return (f"{pipeline.message}; {pipeline.n_simulations} simulations ({pipeline.stages[0].n_samples} on the "
                 "lines of the global model)")

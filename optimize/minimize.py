@@ -130,7 +130,7 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
         executor = stack.enter_context(make_executor(workers=workers, scheduler=scheduler))
         sampler = Sampler(problem, db, executor, progress, retry_failed)
         result = run_method(problem, method, opts, sampler, log)
-        if result.method == "sparse" and opts.validation_lines > 0:
+        if result.get("pipeline") is not None and opts.validation_lines > 0:  # not when handed to auto
             result["validation"] = validate(result.model, ModelSpace(problem), sampler, opts.validation_lines,
                                             opts.validation_points, opts.seed, f_min=result.fun)
             result["trust"] = study_trust(result.stages[0], result.pipeline.best, result.validation)

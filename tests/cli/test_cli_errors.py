@@ -188,3 +188,24 @@ def test_truth_and_feasible_make_no_folder_for_nothing(tmp_path):
     proc = mechopt("feasible", "--study", "hartmann6", "--out", str(tmp_path / "h"))
     assert proc.returncode == 0 and "declares no constraints" in proc.stdout, proc.stdout + proc.stderr
     assert not (tmp_path / "r").exists() and not (tmp_path / "h").exists()
+
+
+def test_a_study_whose_every_simulation_fails_and_one_whose_line_model_hands_over(tmp_path):
+    # A copied command study whose command is broken: the study said "a design must have finite values, got (nan,
+    # nan, nan)" (auto) or raised AttributeError: pipeline (sparse, handed to auto), and the sparse run simulated 17
+    # designs for a budget of 10 (the line plan's designs outside the box, clipped onto it by auto).
+    assert mechopt("init", "ventilator-command", "--to", "vc", cwd=tmp_path).returncode == 0
+    toml = tmp_path / "vc" / "study.toml"
+    toml.write_text(toml.read_text().replace("simulate_ventilator.py", "nosuch.py").replace(
+        'name = "ventilator-command"', 'name = "vc-broken"'))  # renamed, as init advises: its table was copied
+    for method in ("auto", "sparse"):
+        proc = mechopt("study", "vc/study.toml", "--method", method, "--budget", "10", "--workers", "1",
+                       "--no-progress", "--out", method, cwd=tmp_path)
+        one_line(proc, "vc-broken: none of the 10 simulations succeeded, the first failed with: SimulatorFailure: "
+                 "exit code 2", "nosuch.py", f"recorded in {method}/samples.sqlite")
+    # Some simulations fail: the line model hands over to auto, and the study writes its report.
+    proc = mechopt("study", "failing_hartmann3", "--method", "sparse", "--budget", "60", "--workers", "1",
+                   "--no-progress", "--out", "fh", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    result = json.loads((tmp_path / "fh" / "result.json").read_text())
+    assert "the line model could not be built" in result["message"] and result["simulations"]["optimisation"] == 60
