@@ -109,6 +109,8 @@ def plot_feasible_slices(problem: DesignProblem, path: str | Path, marks: Mappin
     fig, axes = plt.subplots(1, len(slices), figsize=(width, 6.2 if d == 2 else 4.9), squeeze=False)
     handles: dict[str, object] = {}
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    if len(problem.constraints) > len(colors):  # path synthesis has 14: one colour, one constraint
+        colors = [plt.cm.tab20(i) for i in range(20)]
     for ax, value in zip(axes[0], slices, strict=True):
         X = np.tile(base, (GX.size, 1))
         if value is not None:
@@ -129,9 +131,9 @@ def plot_feasible_slices(problem: DesignProblem, path: str | Path, marks: Mappin
             for k, name in enumerate(problem.constraints):
                 values = np.nan_to_num(M[:, k].reshape(GX.shape), nan=-1.0, neginf=-1.0)
                 if values.min() < 0 < values.max():
-                    color = colors[k % len(colors)]
-                    ax.contour(GX, GY, values, levels=[0.0], colors=[color], linewidths=1.6)
-                    handles[name] = plt.Line2D([], [], color=color, lw=1.6, label=f"{name} = 0")
+                    color, style = colors[k % len(colors)], ("-", "--", ":")[k // len(colors) % 3]
+                    ax.contour(GX, GY, values, levels=[0.0], colors=[color], linewidths=1.6, linestyles=style)
+                    handles[name] = plt.Line2D([], [], color=color, lw=1.6, ls=style, label=f"{name} = 0")
         _draw_marks(ax, problem, marks, value, ix, iy)
         v = problem.variables
         ax.set_xlabel(v[ix].axis_label)
