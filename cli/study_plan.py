@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from mechopt.optimize.sparse.model import ObjectiveModel
 from mechopt.optimize.sparse.options import SparseOptions
 from mechopt.optimize.sparse.space import ModelSpace
 from mechopt.optimize.sparse.stage import planned_designs
@@ -253,8 +254,8 @@ def _line_stage(study: Study, options: SparseOptions, store: SampleStore | None,
                      _held(store, on_lines, study.problem.fingerprint(), retry_failed))
 
 
-def plan_validation(study: Study, options: SparseOptions, store: SampleStore | None, workers: int, model=None,
-                    retry_failed: bool = False) -> RunPlan:
+def plan_validation(study: Study, options: SparseOptions, store: SampleStore | None, workers: int,
+                    model: ObjectiveModel | None = None, retry_failed: bool = False) -> RunPlan:
     """The plan of ``mechopt validate``: the line model's lines when there is no saved ``model``, then the held-out
     lines.  With a saved model they are placed here as the run will place them (seeded, no simulation), and the store
     is asked which it holds; a model still to be fitted places them later, so ``validation_lines`` of

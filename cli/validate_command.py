@@ -45,6 +45,7 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
     """Validate the saved (or a refitted) model on held-out lines; print the errors, write the figure."""
     from mechopt.cli.run_study import check_output_folder, plan_validate, study_options
     from mechopt.optimize.arguments import check_budget
+    from mechopt.report.plots import plot_validation
 
     study = load(args)
     if args.budget is not None:
@@ -65,8 +66,6 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
     val, model, fit_lines, counts = _simulate(args, study, options, check_output_folder(out), store_path, model, f_min)
     if val.n_points == 0:
         raise MechoptError("no held-out line could be placed inside the model's hull; nothing validated")
-    from mechopt.report.plots import plot_validation
-
     figure = plot_validation(val.lines, out / "figures" / "validation_heldout.png", fit_lines, model,
                              label=study.problem.objective)
     (out / "validation.json").write_text(json.dumps(val.summary(), indent=2))
