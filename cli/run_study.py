@@ -149,14 +149,8 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
                     "references": len(sampler.designs) - n_opt - n_val, "optimisation_timing": timing}
         failures = [(np.array(d), e) for d, e in sampler.failures.values()]
     ground = _ground_truth(problem, out, truth, truth_step, timings)
-    lines = result.get("pipeline") is not None  # False for a sparse run whose failures handed it to auto
-    if lines:
-        result["trust"] = study_trust(result.stages[0], result.pipeline.best, validation)
-    if result.get("trust"):
-        log(f"  trust: {result.trust['verdict']}")
+    _line_model_verdict(result, validation, n_opt, log)
     result.update(validation=validation, outputs=references["optimum"]["outputs"])
-    if lines:
-        result["nfev"] = n_opt  # the pipeline's designs, confirmation and refinement included
     timings["total_s"] = time.perf_counter() - t_all
     run = StudyRun(study, options, result, validation, references, ground, timings, out, store_path, sampling,
                    failures, plan)
@@ -180,6 +174,17 @@ def plan_study(study: Study, options: SparseOptions, workers: int | None = None,
     finally:
         if store is not None:
             store.close()
+
+
+def _line_model_verdict(result: OptimizeResult, validation: Validation | None, n_opt: int,
+                        log: Callable[[str], None]) -> None:
+    """The trust report of a run with a line model, and its simulations counted as the study's (the pipeline's
+    designs, confirmation and refinement); nothing for a sparse run whose failures handed it to auto."""
+    if result.get("pipeline") is not None:
+        result["trust"] = study_trust(result.stages[0], result.pipeline.best, validation)
+        result["nfev"] = n_opt
+    if result.get("trust"):
+        log(f"  trust: {result.trust['verdict']}")
 
 
 def _check_some_succeeded(study: Study, result: OptimizeResult, sampler: Sampler, store_path: Path) -> None:
