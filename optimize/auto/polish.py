@@ -14,7 +14,7 @@ from scipy.optimize import minimize
 
 from mechopt.optimize.auto.gp import GaussianProcess
 
-__all__ = ["polish_on_constraints"]
+__all__ = ["nearest_feasible", "polish_on_constraints"]
 
 
 def polish_on_constraints(gp: GaussianProcess, centre: np.ndarray, lo: np.ndarray, hi: np.ndarray,
@@ -41,3 +41,26 @@ def polish_on_constraints(gp: GaussianProcess, centre: np.ndarray, lo: np.ndarra
                    options={"maxiter": 100, "ftol": 1e-10})
     x = np.clip(res.x, lo, hi)
     return x if allowed(x[None, :])[0] else None
+
+
+def nearest_feasible(u: np.ndarray, keep: int, margins: Callable[[np.ndarray], np.ndarray],
+                     active: np.ndarray | None = None, origin: np.ndarray | None = None) -> np.ndarray | None:
+    """The design nearest ``u`` (unit cube) with variable ``keep`` held at ``u[keep]`` that satisfies the declared
+    constraints, with the constraints ``active`` (indices) held at their margins at ``origin`` (the design ``u`` was
+    moved from); None when SLSQP finds none.
+
+    A probe moved off a bound at a vertex of the bound and an active constraint either leaves the feasible region
+    or leaves the constraint; the constrained optimum moves off the bound along the constraint, so the probe slides
+    the other variables to stay on it.
+    """
+    d = u.size
+    bounds = [(u[j], u[j]) if j == keep else (0.0, 1.0) for j in range(d)]
+    constraints = [{"type": "ineq", "fun": lambda v: margins(v[None, :])[0]}]
+    if active is not None and active.size and origin is not None:
+        held = margins(origin[None, :])[0][active]
+        constraints.append({"type": "eq", "fun": lambda v: margins(v[None, :])[0][active] - held})
+    res = minimize(lambda v: float(np.sum((v - u) ** 2)), u, jac=lambda v: 2.0 * (v - u), method="SLSQP",
+                   bounds=bounds, constraints=constraints, options={"maxiter": 100, "ftol": 1e-12})
+    v = np.clip(res.x, 0.0, 1.0)
+    v[keep] = u[keep]
+    return v if np.all(margins(v[None, :])[0] >= 0.0) else None

@@ -20,7 +20,7 @@ from mechopt.optimize.auto.feasibility import SuccessModel
 from mechopt.optimize.auto.gp import GaussianProcess, fit_gp
 from mechopt.optimize.auto.least_squares_plan import least_squares_plan
 from mechopt.optimize.auto.plan import GLOBAL_MAX_POINTS, Plan, choose_plan
-from mechopt.optimize.auto.polish import polish_on_constraints
+from mechopt.optimize.auto.polish import nearest_feasible, polish_on_constraints
 from mechopt.optimize.auto.transform import standardise
 from mechopt.optimize.auto.trust_region import TrustRegion
 from mechopt.runs.sample_record import KEY_DECIMALS
@@ -240,7 +240,7 @@ def _global_plan(run: _Run, plan: Plan) -> None:
                 first = first if x is None else x[None, :]
             if not probed and first.shape[0] < k:
                 probed = True
-                probes = _bound_probes(run, centre, max(1, plan.n_polish // 2))
+                probes = _bound_probes(run, gp, centre, max(1, plan.n_polish // 2))
                 first = np.vstack([first, probes[: k - first.shape[0]]])
         if first.shape[0] < k:
             U = propose_batch(gp, best, lo, hi, centre, k - first.shape[0], run.rng,
@@ -250,23 +250,42 @@ def _global_plan(run: _Run, plan: Plan) -> None:
         run.simulate(run.fill(first, k))
 
 
-def _bound_probes(run: _Run, centre: np.ndarray, most: int) -> np.ndarray:
+def _bound_probes(run: _Run, gp: GaussianProcess, centre: np.ndarray, most: int) -> np.ndarray:
     """One design a half polish box inside each bound the incumbent sits on (at most ``most``).
 
     A variable the GP finds almost irrelevant (a length-scale of several box widths) looks the same everywhere
     to the model, and expected improvement, whose spread grows toward the faces, drifts onto a face and refines
     the other variables there: the incumbent ends on a bound the model cannot tell from the optimum.  An optimum
     on a bound is common in design (a link at its longest), so it is not assumed away; one simulation inside
-    tests it, and the polish's model then has the difference to act on.
+    tests it, and the polish's model then has the difference to act on.  At a vertex of the bound and a declared
+    constraint the probe slides along the constraint (the ventilator's optimum lies on the toggle margin, and 4 of
+    10 runs at 20 simulations stopped where the margin meets |BC|'s lower bound); the model's best probe first.
     """
     step = 0.5 * POLISH_LENGTH
+    active = _active_constraints(run, centre)
     probes = []
     for j in np.flatnonzero((centre <= 1e-9) | (centre >= 1.0 - 1e-9)):
         u = centre.copy()
         u[j] = step if centre[j] <= 1e-9 else 1.0 - step
-        probes.append(u)
+        if active is not None and (active.size or not run.declared(u)[0]):
+            # Off a vertex of the bound and a constraint, along the constraint (polish.nearest_feasible).
+            u = nearest_feasible(u, j, run.unit_margins, active, centre)
+        if u is not None:
+            probes.append(u)
     P = np.array(probes).reshape(-1, centre.size)
-    return P[run.allowed(P)][:most] if P.shape[0] else P
+    P = P[run.allowed(P)] if P.shape[0] else P
+    # The model's best guess first: off a vertex, most bounds lead uphill, and the budget allows few probes.
+    return P[np.argsort(gp.predict(P)[0])][:most] if P.shape[0] > most else P
+
+
+def _active_constraints(run: _Run, centre: np.ndarray) -> np.ndarray | None:
+    """Indices of the declared constraints active at ``centre``: a margin within 1 % of that margin's spread over
+    the designs simulated; None when the problem declares none."""
+    if run.margins is None:
+        return None
+    M = run.unit_margins(np.vstack([run.U, centre]))
+    spread = np.ptp(np.where(np.isfinite(M), M, np.nan), axis=0)
+    return np.flatnonzero(M[-1] <= 0.01 * np.nan_to_num(spread))
 
 
 def _apart(U: np.ndarray, chosen: np.ndarray) -> np.ndarray:
