@@ -30,12 +30,12 @@ from mechopt.optimize.sparse.sampler import Sampler
 from mechopt.optimize.sparse.space import ModelSpace
 from mechopt.optimize.sparse.trust import study_trust
 from mechopt.optimize.sparse.validate import Validation, validate
-from mechopt.runs.executors import default_workers, make_executor
+from mechopt.runs.executors import check_reachable, default_workers, make_executor
 from mechopt.runs.store import SampleStore
 from mechopt.studies.catalogue import Study
 
-__all__ = ["StudyRun", "check_output_folder", "plan_study", "rounds_text", "run_study", "study_options",
-           "summary_lines"]
+__all__ = ["StudyRun", "check_output_folder", "check_run", "plan_study", "rounds_text", "run_study",
+           "study_options", "summary_lines"]
 
 
 @dataclass
@@ -117,7 +117,7 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
     from mechopt.report.study_report import write_outputs
 
     problem = study.problem
-    _check(study, options, method)
+    check_run(study, options, method, scheduler, store_path)
     out = check_output_folder(out)
     store_path = Path(store_path) if store_path else out / "samples.sqlite"
     timings: dict[str, float] = {}
@@ -167,7 +167,7 @@ def plan_study(study: Study, options: SparseOptions, workers: int | None = None,
     Parameters are those of :func:`run_study`; ``store_path`` is read when it exists (a resumed run costs only the
     designs it lacks) and never created.
     """
-    _check(study, options, method)
+    check_run(study, options, method)
     store = open_store_if_any(store_path) if store_path is not None else None
     try:
         return plan_run(study, options, method, store, _count_workers(workers, scheduler), retry_failed)
@@ -197,10 +197,16 @@ def _check_some_succeeded(study: Study, result: OptimizeResult, sampler: Sampler
                        f"with: {first}; they are recorded in {store_path} (--retry-failed simulates them again)")
 
 
-def _check(study: Study, options: SparseOptions, method: str) -> None:
-    """What :func:`mechopt.minimize` checks before any work: the method for this budget, a feasible region."""
+def check_run(study: Study, options: SparseOptions, method: str, scheduler: Any = None,
+              store_path: Path | None = None) -> None:
+    """What :func:`mechopt.minimize` checks before any work (the method for this budget, a feasible region), and
+    before the output folder is made: a store path that is a folder, a scheduler nobody listens at."""
     check_method(method, study.problem.dim, study.name, options.budget, n_lines=options.n_lines)
     study.problem.check_region()
+    if store_path is not None and Path(store_path).is_dir():
+        raise InputError(f"--store {store_path} is a folder; expected the path of an SQLite file")
+    if isinstance(scheduler, str):
+        check_reachable(scheduler)
 
 
 def plan_validate(study: Study, options: SparseOptions, model: Any = None, workers: int | None = None,

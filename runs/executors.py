@@ -39,6 +39,7 @@ __all__ = [
     "InProcessExecutor",
     "ProcessExecutor",
     "SampleExecutor",
+    "check_reachable",
     "default_workers",
     "make_executor",
 ]
@@ -272,8 +273,9 @@ class ProcessExecutor(SampleExecutor):
             self._pool = None
 
 
-def _check_reachable(address: str, timeout: float) -> None:
-    """Fail fast, with one line, when nothing listens at a ``tcp://`` or ``tls://`` scheduler address.
+def check_reachable(address: str, timeout: float = 10.0) -> None:
+    """Fail fast, with one line, when nothing listens at a ``tcp://`` or ``tls://`` scheduler address (``timeout``
+    in s); a command calls it before it makes its output folder.
 
     A ``distributed.Client`` that fails to connect leaves behind an object whose finalizer blocks and prints a
     traceback at exit; a plain socket probe avoids creating it.
@@ -336,7 +338,7 @@ class DaskExecutor(SampleExecutor):
             address = getattr(scheduler, "scheduler_address", scheduler)
             if not isinstance(address, str) or not address:
                 raise InputError(f"the Dask scheduler must be an address like tcp://HOST:PORT, got {scheduler!r}")
-            _check_reachable(address, connect_timeout)
+            check_reachable(address, connect_timeout)
             try:
                 self._client = distributed.Client(address, timeout=connect_timeout, set_as_default=False)
             except (OSError, TimeoutError, ValueError) as exc:

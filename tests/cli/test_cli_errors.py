@@ -190,6 +190,16 @@ def test_truth_and_feasible_make_no_folder_for_nothing(tmp_path):
     assert not (tmp_path / "r").exists() and not (tmp_path / "h").exists()
 
 
+def test_a_study_with_a_folder_for_a_store_or_a_scheduler_nobody_listens_at_makes_no_folder(tmp_path):
+    # Both were found only after the output folder, its figures folder and an empty store had been made.
+    (tmp_path / "folder").mkdir()
+    one_line(mechopt("study", "branin", "--budget", "12", "--store", str(tmp_path / "folder"), "--out",
+                     str(tmp_path / "a")), f"--store {tmp_path / 'folder'} is a folder")
+    one_line(mechopt("study", "branin", "--budget", "12", "--scheduler", "tcp://127.0.0.1:1", "--out",
+                     str(tmp_path / "b")), "cannot reach the Dask scheduler at tcp://127.0.0.1:1")
+    assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()
+
+
 def test_a_study_whose_every_simulation_fails_and_one_whose_line_model_hands_over(tmp_path):
     # A copied command study whose command is broken: the study said "a design must have finite values, got (nan,
     # nan, nan)" (auto) or raised AttributeError: pipeline (sparse, handed to auto), and the sparse run simulated 17
