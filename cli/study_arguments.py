@@ -18,6 +18,11 @@ DEFAULT_STUDY = "ventilator"
 def study_name(args: argparse.Namespace) -> str:
     """The study named on the command line, first word or ``--study`` (both is an error unless they agree)."""
     word, flag = getattr(args, "name", None), getattr(args, "study", None)
+    for given in (word, flag):
+        if given is not None and not given.strip(", "):
+            # An empty name (a shell variable never set) must not quietly run the default study.
+            raise InputError(f"study {given!r} names no study; expected a name such as {DEFAULT_STUDY} (`mechopt "
+                             "studies` lists them) or the path of a study .toml")
     if word and flag and word != flag:
         raise InputError(f"study named twice: {word!r} and --study {flag!r}; expected one of them")
     return word or flag or DEFAULT_STUDY

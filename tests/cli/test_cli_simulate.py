@@ -123,3 +123,11 @@ def test_every_command_takes_the_study_as_its_first_word(capsys, tmp_path):
         err = capsys.readouterr().err
         assert "study named twice: 'hartmann3' and --study 'branin'" in err and err.count("\n") == 1
     assert not (tmp_path / "b").exists()
+
+
+def test_an_empty_study_name_is_refused_not_read_as_the_default(capsys):
+    # `mechopt compare ""` (an unset shell variable) ran every method on the ventilator.
+    for command in (["compare", ""], ["study", "--study", "", "--dry-run"], ["compare", ","]):
+        assert main(command) == EXIT_ERROR
+        err = capsys.readouterr().err
+        assert "names no study; expected a name such as ventilator" in err and err.count("\n") == 1
