@@ -103,10 +103,10 @@ def _copy_shared_data(folder: Path, to: Path) -> list[str]:
 
 def run_init(args: argparse.Namespace, rest: list[str]) -> int:
     """Copy a packaged study's files into a new folder."""
-    from mechopt.studies.catalogue import STUDIES_DIR
+    from mechopt.studies.catalogue import STUDIES_DIR, packaged_studies
     from mechopt.studies.test_functions import SUITE
 
-    files = sorted(p.parent.name.replace("_", "-") for p in STUDIES_DIR.glob("*/study.toml"))
+    files = packaged_studies()
     if args.name in SUITE:
         # A test function is a class, not a file: there is nothing to copy, and the list below must not name it.
         raise InputError(f"{args.name!r} is a test function (a Python class), not a study file to copy; expected one "

@@ -30,14 +30,7 @@ def add_parser(sub, engines: tuple[str, ...]) -> None:
 
 def run(args: argparse.Namespace, rest: list[str]) -> int:
     """Run the study named on the command line and print its summary."""
-    from mechopt.cli.run_study import (
-        check_output_folder,
-        check_run,
-        plan_study,
-        run_study,
-        study_options,
-        summary_lines,
-    )
+    from mechopt.cli.run_study import plan_study, run_study, study_options, summary_lines
     from mechopt.optimize.arguments import DEFAULT_METHOD, check_budget, check_method
 
     study = load(args)
@@ -61,12 +54,11 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
         print("\n".join([*study_header(study), f"  store {store}", *plan.text()]))
         print("dry run: nothing simulated")
         return 0
-    check_run(study, options, args.method, args.scheduler, args.store)
-    out = check_output_folder(out_arg)
-    run = run_study(study, out, options, workers=args.workers, scheduler=args.scheduler, store_path=args.store,
+    # run_study checks the run (store, scheduler, feasible region) before it makes the output folder.
+    run = run_study(study, out_arg, options, workers=args.workers, scheduler=args.scheduler, store_path=args.store,
                     progress=not args.no_progress, truth=args.truth, truth_step=args.truth_grid,
                     retry_failed=args.retry_failed, method=args.method)
     print("\n".join(summary_lines(run)))
-    print(f"report: {out / 'report.md'}")
+    print(f"report: {run.out / 'report.md'}")
     return 0
 

@@ -57,11 +57,9 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
     f_min = _best_known(out, study)
     if model is not None and not np.isfinite(f_min):
         raise InputError(f"no best design known in {out}: run `mechopt study` first, or pass --refit")
-    # What the run will simulate, before it does: without a saved model that is a whole line model first.
-    plan = plan_validate(study, options, model, args.workers, args.scheduler, store_path, args.retry_failed)
-    print("\n".join(plan.text()))
     if args.dry_run:
-        print("dry run: nothing simulated")
+        plan = plan_validate(study, options, model, args.workers, args.scheduler, store_path, args.retry_failed)
+        print("\n".join([*plan.text(), "dry run: nothing simulated"]))
         return 0
     val, model, fit_lines, counts = _simulate(args, study, options, check_output_folder(out), store_path, model, f_min)
     if val.n_points == 0:
@@ -81,6 +79,7 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
 def _simulate(args: argparse.Namespace, study, options, out: Path, store_path: Path, model, f_min: float):
     """Fit the line model if there is none (saved beside the run), then simulate the held-out lines; the validation,
     the model, the lines it was fitted on (None: read) and a line saying what was simulated and what reused."""
+    from mechopt.cli.study_plan import plan_validation
     from mechopt.optimize.sparse.sampler import Sampler
     from mechopt.optimize.sparse.space import ModelSpace
     from mechopt.optimize.sparse.stage import build_stage
@@ -91,6 +90,8 @@ def _simulate(args: argparse.Namespace, study, options, out: Path, store_path: P
     space = ModelSpace(study.problem)
     fit_lines = None
     with SampleStore(store_path) as store, make_executor(args.workers, args.scheduler) as executor:
+        # What the run will simulate, before it does: without a saved model that is a whole line model first.
+        print("\n".join(plan_validation(study, options, store, executor.workers, model, args.retry_failed).text()))
         sampler = Sampler(study.problem, store, executor, not args.no_progress, retry_failed=args.retry_failed)
         if model is None:
             stage = build_stage("global", space, options, sampler, options.n_lines, options.samples_per_line,

@@ -23,7 +23,7 @@ from mechopt.optimize.problem import DesignProblem
 from mechopt.studies.registry import mechanism_factory
 from mechopt.studies.study_file import PACKAGED_STUDIES, StudyFile
 
-__all__ = ["STUDIES_DIR", "Study", "available_studies", "load_study"]
+__all__ = ["STUDIES_DIR", "Study", "available_studies", "load_study", "packaged_studies"]
 
 STUDIES_DIR = PACKAGED_STUDIES
 
@@ -93,12 +93,16 @@ class Study:
         return self.file.config if self.file else {}
 
 
+def packaged_studies() -> list[str]:
+    """Names of the study files shipped with mechopt (what ``mechopt init`` can copy)."""
+    return sorted(p.parent.name.replace("_", "-") for p in STUDIES_DIR.glob("*/study.toml"))
+
+
 def available_studies() -> list[str]:
     """Names of the studies shipped with mechopt (and of the multimodal test functions, for ``mechopt compare``)."""
     from mechopt.studies.test_functions import SUITE
 
-    names = [p.parent.name.replace("_", "-") for p in STUDIES_DIR.glob("*/study.toml")]
-    return sorted(names) + sorted(SUITE)
+    return packaged_studies() + sorted(SUITE)
 
 
 def _suite_study(name: str) -> Study | None:
