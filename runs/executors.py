@@ -17,9 +17,11 @@ Use :func:`make_executor` to get one::
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing
 import os
 import pickle
+import signal
 import socket
 import threading
 import time
@@ -28,6 +30,7 @@ from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from itertools import islice
+from pathlib import Path
 from typing import Any, TypeVar
 from urllib.parse import urlsplit
 
@@ -139,8 +142,44 @@ class InProcessExecutor(SampleExecutor):
             yield fn(item)
 
 
+def _start_worker() -> None:
+    """Pool-worker initializer: leave with the parent, and quietly on Ctrl-C."""
+    _die_with_parent()
+    _quiet_interrupt()
+
+
+def _quiet_interrupt() -> None:
+    """Leave SIGINT to the main process; on a Ctrl-C only stop the programs this worker started.
+
+    A Ctrl-C in a terminal reaches the whole foreground process group: every worker as well as the main process.
+    Python's default turned it into a KeyboardInterrupt in each worker, and each printed its traceback (pymunk's
+    callbacks theirs too) under the main process's one line; a worker that left at once, or that the main process
+    terminated, left the pool's semaphores behind and Python warned of them.  So a worker ignores it: a Python
+    simulation in progress ends in milliseconds to seconds, and the main process, which alone writes the store,
+    drops its result.  An external program (a command simulator runs each in a session of its own, out of the
+    terminal's reach) may run for minutes: its process group is killed, so the user does not wait for a result
+    nobody will store.
+    """
+    signal.signal(signal.SIGINT, lambda _signum, _frame: _kill_programs())
+
+
+def _kill_programs() -> None:
+    """SIGKILL the process group of every child process of this process (Linux; elsewhere nothing)."""
+    for children in Path("/proc/self/task").glob("*/children"):
+        try:
+            pids = [int(pid) for pid in children.read_text().split()]
+        except (OSError, ValueError):
+            continue
+        for pid in pids:
+            with contextlib.suppress(OSError):
+                if os.getpgid(pid) == pid:
+                    os.killpg(pid, signal.SIGKILL)
+                else:
+                    os.kill(pid, signal.SIGKILL)
+
+
 def _die_with_parent() -> None:
-    """Pool-worker initializer: exit as soon as the parent process is gone.
+    """Exit as soon as the parent process is gone.
 
     A ``ProcessPoolExecutor`` worker whose parent was SIGKILLed would otherwise block forever on its task
     queue (or keep burning a core), so a killed run would leave orphans behind.
@@ -219,7 +258,7 @@ class ProcessExecutor(SampleExecutor):
         self.max_in_flight = workers + prefetch
         self.description = f"{workers} local process{'es' if workers != 1 else ''}"
         self._pool: ProcessPoolExecutor | None = ProcessPoolExecutor(
-            max_workers=workers, mp_context=_mp_context(), initializer=_die_with_parent
+            max_workers=workers, mp_context=_mp_context(), initializer=_start_worker
         )
         # Start the workers now, in the background, while the method plans its first designs (issue 28: on a busy
         # machine a cold start of 8 workers took seconds, before the first simulation).

@@ -138,32 +138,90 @@ def _sigint_default() -> None:
     signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
+def _stored(store: Path) -> dict[str, int]:
+    """Rows of the store by status ({} while it does not exist or is being created)."""
+    if not store.exists():
+        return {}
+    try:
+        with sqlite3.connect(store) as con:
+            return dict(con.execute("SELECT status, COUNT(*) FROM samples GROUP BY status").fetchall())
+    except sqlite3.Error:
+        return {}
+
+
+def _ctrl_c(args: list[str], ready, cwd: Path | None = None) -> tuple[subprocess.CompletedProcess, float]:
+    """Run ``mechopt ARGS`` in a process group of its own, press Ctrl-C once ``ready()`` (SIGINT to the whole group,
+    as a terminal sends it: the workers get it too); the finished process and the seconds it took to exit."""
+    proc = subprocess.Popen([sys.executable, "-m", "mechopt.cli.main", *args], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, cwd=cwd, env={**os.environ, "MPLBACKEND": "Agg"},
+                            preexec_fn=_sigint_default, start_new_session=True)
+    try:
+        deadline = time.time() + 240
+        while not ready() and proc.poll() is None and time.time() < deadline:
+            time.sleep(0.5)
+        assert proc.poll() is None, "the run ended before the Ctrl-C"
+        os.killpg(proc.pid, signal.SIGINT)
+        t0 = time.time()
+        out, err = proc.communicate(timeout=120)
+        return subprocess.CompletedProcess(proc.args, proc.returncode, out, err), time.time() - t0
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)
+
+
+def _assert_interrupted(proc: subprocess.CompletedProcess) -> None:
+    assert proc.returncode == 130, proc.stderr
+    lines = [line for line in proc.stderr.strip().splitlines() if line.strip()]
+    # One line: no traceback of the workers (nor of pymunk's callbacks), no warning of leaked semaphores.
+    assert len(lines) == 1 and "interrupted" in lines[0] and "Traceback" not in proc.stderr, proc.stderr
+
+
 def test_ctrl_c_leaves_one_line_and_an_intact_store(tmp_path):
     store = tmp_path / "s.sqlite"
-    proc = subprocess.Popen([sys.executable, "-m", "mechopt.cli.main", "study", "--out", str(tmp_path / "o"),
-                             "--store", str(store), "--engine", "pymunk", "--workers", "2", "--no-progress",
-                             "--lines-fit", "21", "--samples-per-line", "25"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            env={**os.environ, "MPLBACKEND": "Agg"}, preexec_fn=_sigint_default)
-    # Interrupt once some designs are stored.
-    deadline = time.time() + 240
-    while time.time() < deadline:
-        time.sleep(1.0)
-        if store.exists():
-            try:
-                with sqlite3.connect(store) as con:
-                    if con.execute("SELECT COUNT(*) FROM samples").fetchone()[0] >= 5:
-                        break
-            except sqlite3.Error:
-                pass
-    proc.send_signal(signal.SIGINT)
-    _, err = proc.communicate(timeout=120)
-    assert proc.returncode == 130, err
-    lines = [line for line in err.strip().splitlines() if line.strip()]
-    assert len(lines) == 1 and "interrupted" in lines[0] and "Traceback" not in err, err
+    proc, _ = _ctrl_c(["study", "--out", str(tmp_path / "o"), "--store", str(store), "--engine", "pymunk",
+                       "--workers", "2", "--no-progress", "--lines-fit", "21", "--samples-per-line", "25"],
+                      lambda: sum(_stored(store).values()) >= 5)
+    _assert_interrupted(proc)
     with sqlite3.connect(store) as con:
         assert con.execute("PRAGMA integrity_check").fetchone()[0] == "ok"
         assert con.execute("SELECT COUNT(*) FROM samples").fetchone()[0] >= 5
+
+
+COMMAND_SLEEPING = """import json, sys, time
+design = json.load(sys.stdin)
+time.sleep(float(sys.argv[1]) if design["x"] > 0.5 else 0.0)
+print(json.dumps({"f": (design["x"] - 0.3) ** 2 + (design["y"] - 0.6) ** 2}))
+"""
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="a worker finds its programs in Linux /proc")
+def test_ctrl_c_stops_the_programs_in_progress(tmp_path):
+    # A CAD run takes minutes; its program runs in a session of its own, out of the terminal's reach.  After a
+    # Ctrl-C the user waits neither for it nor for its orphan, and its killed run is not stored as a failure.
+    (tmp_path / "sim.py").write_text(COMMAND_SLEEPING)
+    (tmp_path / "slow.toml").write_text(
+        'name = "slow"\nkind = "external"\n[variables]\nx = [0.0, 1.0]\ny = [0.0, 1.0]\n[simulator]\n'
+        'command = ["{python}", "-S", "sim.py", "300"]\noutputs = ["f"]\n')
+    store = tmp_path / "o" / "samples.sqlite"
+    proc, seconds = _ctrl_c(["study", str(tmp_path / "slow.toml"), "--method", "auto", "--budget", "12",
+                             "--workers", "2", "--out", str(tmp_path / "o"), "--no-progress"],
+                            lambda: _stored(store).get("ok", 0) >= 2 and _running("sim.py 300"))
+    _assert_interrupted(proc)
+    assert seconds < 60, seconds
+    deadline = time.time() + 30
+    while _running("sim.py 300") and time.time() < deadline:
+        time.sleep(0.2)
+    assert not _running("sim.py 300"), "a program outlived the run"
+    assert "failed" not in _stored(store), _stored(store)
+
+
+def _running(text: str) -> bool:
+    """Whether a live process's command line contains ``text`` (Linux /proc)."""
+    for cmdline in Path("/proc").glob("[0-9]*/cmdline"):
+        with contextlib.suppress(OSError):
+            if text in cmdline.read_bytes().replace(b"\0", b" ").decode(errors="replace"):
+                return True
+    return False
 
 
 def test_budget_below_the_methods_minimum(tmp_path):

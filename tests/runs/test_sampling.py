@@ -403,3 +403,33 @@ def test_ctrl_c_mid_run_releases_claims_and_keeps_every_result(tmp_path):
                              executor=InProcessExecutor(), progress=False)
         assert (res.n_cached, res.n_computed) == (len(stored), n - len(stored))
     assert not (Counter(calls(counter)) - calls_1).keys() & stored
+
+
+IDLE_POOL_SCRIPT = """
+import sys, time
+from mechopt.runs.executors import make_executor
+with make_executor(workers=2) as ex:
+    list(ex.map_unordered(abs, [-1, -2, -3, -4]))
+    print("ready", flush=True)
+    try:
+        time.sleep(120)
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+"""
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs POSIX process groups")
+def test_a_terminal_ctrl_c_is_left_to_the_main_process(tmp_path):
+    # A terminal sends SIGINT to the whole process group: idle pool workers printed a KeyboardInterrupt traceback
+    # each under the run's one line.
+    proc = subprocess.Popen([sys.executable, "-c", IDLE_POOL_SCRIPT], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, start_new_session=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    try:
+        assert proc.stdout.readline().strip() == "ready"
+        os.killpg(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert err.strip() == "interrupted", err
