@@ -311,6 +311,21 @@ class ProcessExecutor(SampleExecutor):
             self._pool.shutdown(wait=True, cancel_futures=True)
             self._pool = None
 
+    def __exit__(self, exc_type: type[BaseException] | None, *exc: object) -> None:
+        if exc_type is not None and issubclass(exc_type, KeyboardInterrupt):
+            self._interrupt_workers()
+        self.close()
+
+    def _interrupt_workers(self) -> None:
+        """Pass an interrupt of the main process alone (a notebook's stop, ``kill -INT``, the SIGTERM of
+        :mod:`mechopt.cli.main`) on to the workers, which stop the programs they started (:func:`_quiet_interrupt`):
+        the shutdown then waits for no external program."""
+        if self._pool is None or os.name != "posix":
+            return
+        for process in list((getattr(self._pool, "_processes", None) or {}).values()):
+            with contextlib.suppress(OSError, TypeError):
+                os.kill(process.pid, signal.SIGINT)
+
 
 def check_reachable(address: str, timeout: float = 10.0) -> None:
     """Fail fast, with one line, when nothing listens at a ``tcp://`` or ``tls://`` scheduler address (``timeout``

@@ -149,18 +149,21 @@ def _stored(store: Path) -> dict[str, int]:
         return {}
 
 
-def _ctrl_c(args: list[str], ready, cwd: Path | None = None) -> tuple[subprocess.CompletedProcess, float]:
-    """Run ``mechopt ARGS`` in a process group of its own, press Ctrl-C once ``ready()`` (SIGINT to the whole group,
-    as a terminal sends it: the workers get it too); the finished process and the seconds it took to exit."""
+def _ctrl_c(args: list[str], ready, sig: int = signal.SIGINT,
+            group: bool = True) -> tuple[subprocess.CompletedProcess, float]:
+    """Run ``mechopt ARGS`` in a process group of its own and, once ``ready()``, send it ``sig``: by default a
+    Ctrl-C, SIGINT to the whole group as a terminal sends it (the workers get it too); with ``group`` False to the
+    main process alone (``kill``, ``timeout``, a batch scheduler).  The finished process and the seconds it took to
+    exit."""
     proc = subprocess.Popen([sys.executable, "-m", "mechopt.cli.main", *args], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, cwd=cwd, env={**os.environ, "MPLBACKEND": "Agg"},
+                            stderr=subprocess.PIPE, text=True, env={**os.environ, "MPLBACKEND": "Agg"},
                             preexec_fn=_sigint_default, start_new_session=True)
     try:
         deadline = time.time() + 240
         while not ready() and proc.poll() is None and time.time() < deadline:
             time.sleep(0.5)
         assert proc.poll() is None, "the run ended before the Ctrl-C"
-        os.killpg(proc.pid, signal.SIGINT)
+        (os.killpg if group else os.kill)(proc.pid, sig)
         t0 = time.time()
         out, err = proc.communicate(timeout=120)
         return subprocess.CompletedProcess(proc.args, proc.returncode, out, err), time.time() - t0
@@ -169,11 +172,11 @@ def _ctrl_c(args: list[str], ready, cwd: Path | None = None) -> tuple[subprocess
             os.killpg(proc.pid, signal.SIGKILL)
 
 
-def _assert_interrupted(proc: subprocess.CompletedProcess) -> None:
-    assert proc.returncode == 130, proc.stderr
+def _assert_interrupted(proc: subprocess.CompletedProcess, code: int = 130, word: str = "interrupted") -> None:
+    assert proc.returncode == code, proc.stderr
     lines = [line for line in proc.stderr.strip().splitlines() if line.strip()]
     # One line: no traceback of the workers (nor of pymunk's callbacks), no warning of leaked semaphores.
-    assert len(lines) == 1 and "interrupted" in lines[0] and "Traceback" not in proc.stderr, proc.stderr
+    assert len(lines) == 1 and word in lines[0] and "Traceback" not in proc.stderr, proc.stderr
 
 
 def test_ctrl_c_leaves_one_line_and_an_intact_store(tmp_path):
@@ -195,9 +198,13 @@ print(json.dumps({"f": (design["x"] - 0.3) ** 2 + (design["y"] - 0.6) ** 2}))
 
 
 @pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="a worker finds its programs in Linux /proc")
-def test_ctrl_c_stops_the_programs_in_progress(tmp_path):
+@pytest.mark.parametrize(("sig", "group", "code", "word"), [(signal.SIGINT, True, 130, "interrupted"),
+                                                            (signal.SIGTERM, False, 143, "terminated (SIGTERM)")])
+def test_a_stop_ends_the_programs_in_progress(tmp_path, sig, group, code, word):
     # A CAD run takes minutes; its program runs in a session of its own, out of the terminal's reach.  After a
-    # Ctrl-C the user waits neither for it nor for its orphan, and its killed run is not stored as a failure.
+    # Ctrl-C, or a SIGTERM to mechopt alone (`timeout`, a batch scheduler: Python's default ended the process on
+    # the spot, its claims left in the store), the user waits neither for the program nor for its orphan, and its
+    # killed run is not stored as a failure.
     (tmp_path / "sim.py").write_text(COMMAND_SLEEPING)
     (tmp_path / "slow.toml").write_text(
         'name = "slow"\nkind = "external"\n[variables]\nx = [0.0, 1.0]\ny = [0.0, 1.0]\n[simulator]\n'
@@ -205,14 +212,16 @@ def test_ctrl_c_stops_the_programs_in_progress(tmp_path):
     store = tmp_path / "o" / "samples.sqlite"
     proc, seconds = _ctrl_c(["study", str(tmp_path / "slow.toml"), "--method", "auto", "--budget", "12",
                              "--workers", "2", "--out", str(tmp_path / "o"), "--no-progress"],
-                            lambda: _stored(store).get("ok", 0) >= 2 and _running("sim.py 300"))
-    _assert_interrupted(proc)
+                            lambda: _stored(store).get("ok", 0) >= 2 and _running("sim.py 300"), sig, group)
+    _assert_interrupted(proc, code, word)
     assert seconds < 60, seconds
     deadline = time.time() + 30
     while _running("sim.py 300") and time.time() < deadline:
         time.sleep(0.2)
     assert not _running("sim.py 300"), "a program outlived the run"
     assert "failed" not in _stored(store), _stored(store)
+    with sqlite3.connect(store) as con:
+        assert con.execute("SELECT COUNT(*) FROM claims").fetchone()[0] == 0
 
 
 def _running(text: str) -> bool:

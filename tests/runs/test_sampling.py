@@ -410,8 +410,8 @@ import sys, time
 from mechopt.runs.executors import make_executor
 with make_executor(workers=2) as ex:
     list(ex.map_unordered(abs, [-1, -2, -3, -4]))
-    print("ready", flush=True)
     try:
+        print("ready", flush=True)
         time.sleep(120)
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
