@@ -313,9 +313,14 @@ def _simulations_line(run: StudyRun) -> str:
 
 
 def rounds_text(s: dict[str, Any]) -> str:
-    """The parallel accounting of a run (issue 28): rounds, the workers' idle share, waiting and computing."""
-    if "rounds" not in s:
+    """The parallel accounting of a run (issue 28): rounds, the workers' idle share, waiting and computing.
+
+    A round is as the plan printed before the run counts it: simulations one after the other, up to ``workers`` at
+    a time (the sampler's ``waves``; 8 Sobol designs on 2 workers are 4 rounds).  The method's calls to the
+    simulators (``rounds`` in ``result.json``, 1 for those 8) read as fewer rounds than the plan had promised.
+    """
+    if "waves" not in s:
         return "rounds not counted"
-    return (f"{s['rounds']} round{'' if s['rounds'] == 1 else 's'} of simulations on {s['workers']} "
+    return (f"{s['waves']} round{'' if s['waves'] == 1 else 's'} of simulations on {s['workers']} "
             f"worker{'' if s['workers'] == 1 else 's'} (idle {s['idle_share']:.0%} of their time), "
             f"{s['waiting_s']:.1f} s waiting for simulations, {s['method_s']:.1f} s of the method's own computing")

@@ -135,6 +135,8 @@ def test_budget_60_costs_at_most_72_designs_and_says_so(runs):
     assert sims["rounds"] < sims["new"] and 0 <= sims["idle_share"] <= 1 and sims["workers"] == 2
     assert sims["optimisation_timing"]["rounds"] <= sims["rounds"] and result["plan"]["rounds"] < 72
     assert "rounds of simulations on 2 workers (idle" in text and "s of the method's own computing" in text
+    # Rounds as the plan counts them (simulations one after the other, 2 at a time), not the method's calls.
+    assert f"; {sims['waves']} rounds of simulations on 2 workers" in text and sims["waves"] >= sims["rounds"]
     report = (store.parent / "report.md").read_text()
     assert "on top of the budget, 20% of it" in report and ".." not in report.replace("../", "")
     # Errors against the range of the values, never a percentage of a best value near 0.
