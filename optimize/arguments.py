@@ -11,7 +11,7 @@ import numpy as np
 from mechopt.errors import InputError
 
 __all__ = ["AUTO_METHOD", "MIN_BUDGET", "SPARSE_METHODS", "available_methods", "check_budget", "check_method",
-           "check_seed", "check_workers", "handles_dim", "method_min_budget"]
+           "check_seed", "check_workers", "check_x0", "handles_dim", "method_min_budget"]
 
 #: The fewest simulations any method is given: a model needs a few designs before it can propose one.
 MIN_BUDGET = 3
@@ -59,6 +59,42 @@ def check_workers(workers: Any) -> int | None:
     if workers is not None and (not _whole(workers) or workers < 1):
         raise InputError(f"workers = {workers!r}: expected a whole number >= 1")
     return workers
+
+
+def check_x0(problem: Any, x0: Any, budget: int) -> np.ndarray | None:
+    """``x0`` as an (m, d) array of designs inside the box that satisfy the declared constraints and leave the
+    method a budget (None when not given), or an :class:`InputError` naming the offending design."""
+    if x0 is None:
+        return None
+    try:
+        X = np.array(x0, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"x0 = {x0!r}: expected a design of {problem.dim} numbers, or a list of such "
+                         "designs") from None
+    X = X[None, :] if X.ndim == 1 else X
+    if X.ndim != 2 or X.shape[1] != problem.dim or X.shape[0] == 0:
+        raise InputError(f"x0 of shape {np.shape(x0)}: expected ({problem.dim},) or (m, {problem.dim}) for the "
+                         f"variables {', '.join(problem.names)}")
+    bounds = problem.bounds
+    for x in X:
+        if not np.all(np.isfinite(x)):
+            raise InputError(f"x0 design {x.tolist()} is not finite")
+        outside = np.flatnonzero((x < bounds[:, 0]) | (x > bounds[:, 1]))
+        if outside.size:
+            v = problem.variables[int(outside[0])]
+            raise InputError(f"x0 design {x.tolist()}: {v.name} = {x[outside[0]]:g} lies outside [{v.lower:g}, "
+                             f"{v.upper:g}] {v.unit}")
+    infeasible = np.flatnonzero(~problem.feasible(X))
+    if infeasible.size:
+        x = X[infeasible[0]]
+        margins = problem.constraint_margins(x[None, :])[0] if problem.constraints else np.zeros(0)
+        failing = [f"{c} = {m:.4g}" for c, m in zip(problem.constraints, margins, strict=True) if not m >= 0.0]
+        raise InputError(f"x0 design {problem.describe(x)} violates the declared constraints"
+                         + (f": {', '.join(failing)} (margins must be >= 0)" if failing else ""))
+    if X.shape[0] >= budget:
+        raise InputError(f"x0 holds {X.shape[0]} designs and the budget is {budget}: the designs of x0 count in the "
+                         "budget and leave the method none")
+    return X
 
 
 def check_method(method: Any, dim: int, name: str = "the problem", budget: int | None = None,

@@ -21,6 +21,7 @@ from mechopt.optimize.arguments import (
     check_method,
     check_seed,
     check_workers,
+    check_x0,
 )
 from mechopt.optimize.problem import DesignProblem
 from mechopt.optimize.result import OptimizeResult
@@ -66,7 +67,7 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
              seed: int = 0, workers: int | None = 1, store: str | Path | SampleStore | None = None,
              options: Mapping[str, Any] | SparseOptions | None = None, scheduler: Any = None,
              progress: bool = False, retry_failed: bool = False,
-             log: Callable[[str], None] | None = None) -> OptimizeResult:
+             log: Callable[[str], None] | None = None, x0: Any = None) -> OptimizeResult:
     """Minimise a design problem's objective within a budget of simulations.
 
     Parameters
@@ -88,9 +89,9 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
     seed : int
         Seed of every random choice.
     workers : int, optional
-        Local processes evaluating designs; 1 (default) runs in this process.  None uses every core.  The methods
-        ``"sparse"`` and ``"sparse-global"`` propose as many designs at once as there are workers (Dask: the
-        cluster's worker threads); with one worker they behave exactly as one at a time.
+        Local processes evaluating designs; 1 (default) runs in this process.  None uses every core.  The mechopt
+        methods (``"auto"``, ``"sparse"``, ``"sparse-global"``) propose as many designs at once as there are workers
+        (Dask: the cluster's worker threads); with one worker they behave exactly as one at a time.
     store : path or SampleStore, optional
         SQLite sample store: designs found there (same problem fingerprint) are not simulated again, and every new
         one is committed as soon as it is known.  Default: a temporary store, discarded at the end.
@@ -107,6 +108,10 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
         Simulate again designs whose earlier simulation failed.
     log : callable, optional
         Where progress lines go (default: nowhere).
+    x0 : (d,) or (m, d) array_like, optional
+        Designs to simulate first, in the variables' units: the current design, earlier candidates.  They count in
+        the budget, the result is never worse than the best of them, and ``"auto"`` fits its model to them in place
+        of as many of its space-filling designs.  Inside the bounds and satisfying the declared constraints.
 
     Returns
     -------
@@ -122,14 +127,15 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
         A bad argument, before any simulation.
     """
     _check_arguments(problem, budget, method, seed, workers, store)
-    opts = _checked_options(problem, method, options, int(budget), int(seed))
+    X0 = check_x0(problem, x0, int(budget))
+    opts = _checked_options(problem, method, options, int(budget), int(seed), X0)
     log = log or (lambda _line: None)
     t0 = time.perf_counter()
     with contextlib.ExitStack() as stack:
         db = _open_store(store, stack)
         executor = stack.enter_context(make_executor(workers=workers, scheduler=scheduler))
         sampler = Sampler(problem, db, executor, progress, retry_failed)
-        result = run_method(problem, method, opts, sampler, log)
+        result = run_method(problem, method, opts, sampler, log, x0=X0)
         if result.get("pipeline") is not None and opts.validation_lines > 0:  # not when handed to auto
             result["validation"] = validate(result.model, ModelSpace(problem), sampler, opts.validation_lines,
                                             opts.validation_points, opts.seed, f_min=result.fun)
@@ -175,11 +181,19 @@ def _options(problem: DesignProblem, options: Mapping[str, Any] | SparseOptions 
 
 
 def _checked_options(problem: DesignProblem, method: str | Callable[..., Any],
-                     options: Mapping[str, Any] | SparseOptions | None, budget: int, seed: int) -> SparseOptions:
-    """The options of :func:`_options`; a budget below the method's minimum is refused on them, since the sparse
-    method's minimum depends on its lines, which the options may set."""
-    opts = _options(problem, options, budget, seed)
-    check_method(method, problem.dim, problem.name, opts.budget, n_lines=opts.n_lines)
+                     options: Mapping[str, Any] | SparseOptions | None, budget: int, seed: int,
+                     x0: np.ndarray | None = None) -> SparseOptions:
+    """The options of :func:`_options` for what ``x0`` leaves of the budget; a budget below the method's minimum is
+    refused on them, since the sparse method's minimum depends on its lines, which the options may set."""
+    m = 0 if x0 is None else x0.shape[0]
+    opts = _options(problem, options, budget - m, seed)
+    try:
+        check_method(method, problem.dim, problem.name, opts.budget, n_lines=opts.n_lines)
+    except InputError as exc:
+        if not m:
+            raise
+        raise InputError(f"x0's {m} designs count in budget = {budget}, which leaves {budget - m} to the method: "
+                         f"{exc}") from None
     return opts
 
 
@@ -193,7 +207,7 @@ def _open_store(store: str | Path | SampleStore | None, stack: contextlib.ExitSt
 
 
 def run_method(problem: DesignProblem, method: str | Callable[..., Any], opts: SparseOptions, sampler: Sampler,
-               log: Callable[[str], None]) -> OptimizeResult:
+               log: Callable[[str], None], x0: np.ndarray | None = None) -> OptimizeResult:
     """Run one method on ``problem`` through ``sampler`` (its store and executor), within ``opts.budget``.
 
     The dispatch of :func:`minimize`, shared with ``mechopt study``; arguments are checked by the caller.
@@ -210,12 +224,39 @@ def run_method(problem: DesignProblem, method: str | Callable[..., Any], opts: S
         Where designs are simulated (and found again).
     log : callable
         Where progress lines go.
+    x0 : (m, d) ndarray, optional
+        Checked designs simulated first, on top of ``opts.budget`` (:func:`minimize` takes them out of its budget).
 
     Returns
     -------
     OptimizeResult
         Without ``validation`` (held-out lines are the caller's choice).
     """
+    if x0 is None:
+        return _run(problem, method, opts, sampler, log)
+    values = sampler(x0, desc="x0")
+    if method == AUTO_METHOD:
+        # Its model starts from them (they stand in for as many Sobol designs): the best of them is in its answer.
+        return _auto(problem, int(opts.budget), int(opts.seed), sampler, initial=x0)
+    return _at_least_x0(_run(problem, method, opts, sampler, log), problem, x0, values)
+
+
+def _at_least_x0(result: OptimizeResult, problem: DesignProblem, x0: np.ndarray,
+                 values: np.ndarray) -> OptimizeResult:
+    """``result``, or the best design of ``x0`` when the method found nothing better: a user's current design is
+    never the answer's rival."""
+    if not np.isfinite(values).any():
+        return result
+    i = int(np.nanargmin(values))
+    if result.success and np.isfinite(result.fun) and result.fun <= values[i]:
+        return result
+    result.update(x=np.array(x0[i], dtype=float), fun=float(values[i]), success=True,
+                  message=f"{result.message}; a design of x0 stays the best ({problem.describe(x0[i])})")
+    return result
+
+
+def _run(problem: DesignProblem, method: str | Callable[..., Any], opts: SparseOptions, sampler: Sampler,
+         log: Callable[[str], None]) -> OptimizeResult:
     if method == AUTO_METHOD:
         return _auto(problem, int(opts.budget), int(opts.seed), sampler)
     if method == "sparse":

@@ -112,6 +112,13 @@ def test_baselines_run_through_the_same_entry_point(method):
     ({"options": {"lines": 7}}, "unknown option lines"),
     ({"store": 123}, "store = 123"),
     ({"method": "sparse", "budget": 6}, "needs at least 2 samples on each of its 3 lines + 1 = 7"),
+    ({"x0": [2.5, 0.0]}, "x0 design [2.5, 0.0]: a = 2.5 lies outside [0, 2] mm"),
+    ({"x0": [1.5, 1.5]}, "x0 design a=1.5 mm, b=1.5 mm violates the declared constraints: disc_mm2 = -2.25"),
+    ({"x0": [1.0]}, "x0 of shape (1,): expected (2,) or (m, 2) for the variables a, b"),
+    ({"x0": [[0.1, float("inf")]]}, "x0 design [0.1, inf] is not finite"),
+    ({"x0": np.full((50, 2), 0.5)}, "x0 holds 50 designs and the budget is 50"),
+    ({"x0": np.full((35, 2), 0.5), "method": "sparse-global"}, "x0's 35 designs count in budget = 50, which leaves "
+     "15 to the method: budget = 15: method 'sparse-global' needs at least 10d = 20"),
 ])
 def test_bad_arguments_are_one_line_errors_before_any_work(kwargs, expected):
     with pytest.raises(mechopt.InputError) as info:
@@ -203,3 +210,36 @@ def test_names_given_as_one_string_are_refused():
 
     with pytest.raises(mechopt.InputError, match=r"outputs = 'f'; expected a tuple of names such as \('f',\)"):
         mechopt.minimize(Strings(), budget=30)
+
+
+class _Counting(Bracket):
+    """The bracket, counting its simulations."""
+
+    calls = 0
+
+    def evaluate(self, x):
+        type(self).calls += 1
+        return super().evaluate(x)
+
+
+@pytest.mark.parametrize("method", ["auto", "nelder_mead", "sparse-global"])
+def test_x0_counts_in_the_budget_and_the_answer_is_never_worse(method, tmp_path):
+    # The current design at the constrained optimum (a closed form): no method may answer worse, and x0 is paid
+    # for out of the budget, not on top of it.
+    _Counting.calls = 0
+    current = X_STAR * (1 - 1e-9)
+    result = mechopt.minimize(_Counting(), budget=30, method=method, seed=0, x0=[[0.2, 0.2], current],
+                              store=tmp_path / "s.sqlite")
+    assert _Counting.calls == result.nnew <= 30 and result.nfev <= 30
+    assert result.success and result.fun <= Bracket().evaluate(current)["f"]
+    with SampleStore(tmp_path / "s.sqlite") as store:
+        assert store.count(_Counting().fingerprint()) == result.nnew
+
+
+def test_auto_starts_its_model_from_x0():
+    # x0 stands in for as many of auto's Sobol designs: the budget is spent exactly, x0 included.
+    _Counting.calls = 0
+    x0 = np.array([[0.5, 0.5], [1.0, 0.2], [0.1, 1.4]])
+    result = mechopt.minimize(_Counting(), budget=12, seed=3, x0=x0)
+    assert _Counting.calls == result.nfev == 12
+    assert result.fun == pytest.approx(F_STAR, abs=0.02)
