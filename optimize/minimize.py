@@ -243,8 +243,8 @@ def run_method(problem: DesignProblem, method: str | Callable[..., Any], opts: S
 
 def _at_least_x0(result: OptimizeResult, problem: DesignProblem, x0: np.ndarray,
                  values: np.ndarray) -> OptimizeResult:
-    """``result``, or the best design of ``x0`` when the method found nothing better: a user's current design is
-    never the answer's rival."""
+    """``result``, or the best design of ``x0`` when the method found nothing better: the answer is never worse
+    than the design the user started from."""
     if not np.isfinite(values).any():
         return result
     i = int(np.nanargmin(values))

@@ -162,7 +162,7 @@ def _ctrl_c(args: list[str], ready, sig: int = signal.SIGINT,
         deadline = time.time() + 240
         while not ready() and proc.poll() is None and time.time() < deadline:
             time.sleep(0.5)
-        assert proc.poll() is None, "the run ended before the Ctrl-C"
+        assert proc.poll() is None and ready(), "the run ended, or never got ready, before the Ctrl-C"
         (os.killpg if group else os.kill)(proc.pid, sig)
         t0 = time.time()
         out, err = proc.communicate(timeout=120)
@@ -212,7 +212,7 @@ def test_a_stop_ends_the_programs_in_progress(tmp_path, sig, group, code, word):
     store = tmp_path / "o" / "samples.sqlite"
     proc, seconds = _ctrl_c(["study", str(tmp_path / "slow.toml"), "--method", "auto", "--budget", "12",
                              "--workers", "2", "--out", str(tmp_path / "o"), "--no-progress"],
-                            lambda: _stored(store).get("ok", 0) >= 2 and _running("sim.py 300"), sig, group)
+                            lambda: _stored(store).get("ok", 0) >= 1 and _running("sim.py 300"), sig, group)
     _assert_interrupted(proc, code, word)
     assert seconds < 60, seconds
     deadline = time.time() + 30
