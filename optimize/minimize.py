@@ -234,10 +234,11 @@ def run_method(problem: DesignProblem, method: str | Callable[..., Any], opts: S
     """
     if x0 is None:
         return _run(problem, method, opts, sampler, log)
-    values = sampler(x0, desc="x0")
     if method == AUTO_METHOD:
-        # Its model starts from them (they stand in for as many Sobol designs): the best of them is in its answer.
+        # Its model starts from them (they stand in for as many Sobol designs), which it simulates first: the best
+        # of them is in its answer.
         return _auto(problem, int(opts.budget), int(opts.seed), sampler, initial=x0)
+    values = sampler(x0, desc="x0")
     return _at_least_x0(_run(problem, method, opts, sampler, log), problem, x0, values)
 
 
