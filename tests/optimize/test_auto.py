@@ -201,6 +201,30 @@ def test_gp_gradient_and_fit():
     assert np.argmax(gp.theta[:3]) == 2
 
 
+def test_a_deterministic_function_is_interpolated_to_its_resolution():
+    # A simulator is deterministic: the noise is fitted down to the floor, which is for the factorisation only.
+    # With a floor of 1e-6 the model missed its own designs by 1.1e-4 standard deviations, and a minimiser could
+    # not see the last differences a valley's designs had resolved.
+    rng = np.random.default_rng(3)
+    X = rng.random((30, 2))
+    y = (X[:, 0] - 0.3) ** 2 + 2.0 * (X[:, 1] - 0.6) ** 2 + 0.3 * np.sin(5.0 * X[:, 0])
+    y = (y - y.mean()) / y.std()
+    gp = fit_gp(X, y, rng, prior=False)
+    assert np.exp(gp.theta[-1]) < 1e-8
+    np.testing.assert_allclose(gp.predict(X)[0], y, atol=1e-6)
+
+
+def test_designs_a_hair_apart_factorise_with_jitter():
+    rng = np.random.default_rng(0)
+    X = rng.random((20, 3))
+    X = np.vstack([X, X[:5] + 1e-13])  # what a believer's batch or a polish next to the incumbent can give
+    y = np.sin(3.0 * X.sum(axis=1))
+    gp = GaussianProcess(X, y, np.array([np.log(0.3)] * 3 + [0.0, np.log(1e-20)]))
+    mean, sd = gp.predict(X[:5])
+    assert np.all(np.isfinite(mean)) and np.all(np.isfinite(sd))
+    np.testing.assert_allclose(mean, y[:5], atol=1e-4)
+
+
 def test_mean_level_is_the_limit_of_a_random_constant_of_large_variance():
     # An independent formulation: a zero-mean GP whose kernel has a constant term B·11ᵀ predicts, as B grows, the
     # generalised least-squares level plus the kriging of the residuals (ordinary kriging, Santner et al. 2003).
