@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 
-__all__ = ["Parser", "count", "int_list", "positive_float", "positive_int", "whole_number"]
+__all__ = ["Parser", "count", "float_list", "int_list", "positive_float", "positive_int", "whole_number"]
 
 
 class Parser(argparse.ArgumentParser):
@@ -53,4 +53,14 @@ def int_list(text: str) -> list[int]:
         raise argparse.ArgumentTypeError(f"{text!r} is not a comma-separated list of integers") from None
     if not values or min(values) < 10:
         raise argparse.ArgumentTypeError(f"budgets {text!r}: expected integers >= 10")
+    return values
+
+
+def float_list(text: str) -> list[float]:
+    """An argparse type: a design's values, comma-separated (``--x0 30,70.5,254``); its shape and bounds are the
+    problem's to check."""
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a comma-separated list of numbers") from None
     return values

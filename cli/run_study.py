@@ -23,7 +23,7 @@ from mechopt.cli.study_plan import RunPlan, duration_text, open_store_if_any, pl
 from mechopt.errors import InputError, MechoptError
 from mechopt.optimize.arguments import check_method
 from mechopt.optimize.ground_truth import GroundTruth, load_or_compute
-from mechopt.optimize.minimize import parallel_accounting, run_method
+from mechopt.optimize.minimize import checked_options, parallel_accounting, run_method
 from mechopt.optimize.result import OptimizeResult
 from mechopt.optimize.sparse.options import SparseOptions
 from mechopt.optimize.sparse.sampler import Sampler
@@ -85,7 +85,7 @@ def check_output_folder(out: Path) -> Path:
 def run_study(study: Study, out: Path, options: SparseOptions, workers: int | None = None,
               scheduler: str | None = None, store_path: Path | None = None, progress: bool = True,
               truth: bool = False, truth_step: float = 1.0, retry_failed: bool = False,
-              log: Callable[[str], None] = print, method: str = "sparse") -> StudyRun:
+              log: Callable[[str], None] = print, method: str = "sparse", x0: np.ndarray | None = None) -> StudyRun:
     """Run the study end to end and write its outputs to ``out``.
 
     Parameters
@@ -113,6 +113,8 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
     method : str
         ``"sparse"`` (default), ``"sparse-global"`` or a baseline's name (:func:`mechopt.optimize.arguments.
         available_methods`); held-out validation needs the line model of ``"sparse"``.
+    x0 : (m, d) ndarray, optional
+        Checked designs simulated first; they count in ``options.budget``, as in :func:`mechopt.minimize`.
     """
     from mechopt.report.study_report import write_outputs
 
@@ -128,7 +130,8 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
         for line in [*study_header(study), f"  store {store_path}, {sampler.executor_description}", *plan.text()]:
             log(line)
         t0 = time.perf_counter()
-        result = run_method(problem, method, options, sampler, log)
+        share = options if x0 is None else checked_options(problem, method, options, options.budget, options.seed, x0)
+        result = run_method(problem, method, share, sampler, log, x0=x0)
         timings["optimise_s"] = time.perf_counter() - t0
         n_opt = len(sampler.designs)
         timing = sampler.timing()

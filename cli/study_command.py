@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from mechopt.cli.arguments import count, positive_float
+from mechopt.cli.arguments import count, float_list, positive_float
 from mechopt.cli.study_arguments import add_method_option, add_run_options, add_study_argument, load, overrides
 
 __all__ = ["add_parser", "run"]
@@ -23,6 +23,10 @@ def add_parser(sub, engines: tuple[str, ...]) -> None:
                    "ventilator's full 10 lines x 30 of earlier versions; 0: no validation)")
     p.add_argument("--dry-run", action="store_true",
                    help="print the plan (stages, simulations, expected wall time) and simulate nothing")
+    p.add_argument("--x0", action="append", type=float_list, metavar="VALUES",
+                   help="a design to start from, its variables' values comma-separated in the order and units of "
+                   "`mechopt study STUDY --dry-run`; repeat for several; simulated first and counted in the budget: "
+                   "the answer is never worse")
     p.add_argument("--truth", action="store_true", help="also brute-force the ground truth (cached)")
     p.add_argument("--truth-grid", type=positive_float, default=1.0, help="its grid step (the variables' unit)")
     p.set_defaults(func=run)
@@ -31,7 +35,8 @@ def add_parser(sub, engines: tuple[str, ...]) -> None:
 def run(args: argparse.Namespace, rest: list[str]) -> int:
     """Run the study named on the command line and print its summary."""
     from mechopt.cli.run_study import plan_study, run_study, study_options, summary_lines
-    from mechopt.optimize.arguments import DEFAULT_METHOD, check_budget, check_method
+    from mechopt.optimize.arguments import DEFAULT_METHOD, check_budget, check_method, check_x0
+    from mechopt.optimize.minimize import checked_options
 
     study = load(args)
     args.method = args.method or study.method or DEFAULT_METHOD
@@ -42,6 +47,13 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
     notes: list[str] = []
     options = study_options(study, overrides(args), log=notes.append)
     check_method(args.method, study.problem.dim, study.name, options.budget, n_lines=options.n_lines)
+    # One --x0 is one design, as minimize's x0 of shape (d,): its errors then read the same.
+    x0 = check_x0(study.problem, args.x0[0] if args.x0 and len(args.x0) == 1 else args.x0, options.budget)
+    if x0 is not None:
+        # Refused here, before any output, when x0 leaves the method less than its minimum.
+        left = checked_options(study.problem, args.method, options, options.budget, options.seed, x0).budget
+        notes.append(f"x0: {x0.shape[0]} design(s) simulated first, counted in the budget of {options.budget} (the "
+                     f"method has {left})")
     for note in notes:
         print(note)
     out_arg = Path(args.out or f"{study.name}-study")
@@ -57,7 +69,7 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
     # run_study checks the run (store, scheduler, feasible region) before it makes the output folder.
     run = run_study(study, out_arg, options, workers=args.workers, scheduler=args.scheduler, store_path=args.store,
                     progress=not args.no_progress, truth=args.truth, truth_step=args.truth_grid,
-                    retry_failed=args.retry_failed, method=args.method)
+                    retry_failed=args.retry_failed, method=args.method, x0=x0)
     print("\n".join(summary_lines(run)))
     print(f"report: {run.out / 'report.md'}")
     return 0

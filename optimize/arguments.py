@@ -83,7 +83,7 @@ def check_x0(problem: Any, x0: Any, budget: int) -> np.ndarray | None:
         if outside.size:
             v = problem.variables[int(outside[0])]
             raise InputError(f"x0 design {x.tolist()}: {v.name} = {x[outside[0]]:g} lies outside [{v.lower:g}, "
-                             f"{v.upper:g}] {v.unit}")
+                             f"{v.upper:g}]" + (f" {v.unit}" if v.unit else ""))
     infeasible = np.flatnonzero(~problem.feasible(X))
     if infeasible.size:
         x = X[infeasible[0]]

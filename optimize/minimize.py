@@ -34,7 +34,7 @@ from mechopt.optimize.sparse.validate import validate
 from mechopt.runs.executors import make_executor
 from mechopt.runs.store import SampleStore
 
-__all__ = ["METHODS", "minimize", "parallel_accounting", "run_method"]
+__all__ = ["METHODS", "checked_options", "minimize", "parallel_accounting", "run_method"]
 
 #: ``"sparse"``: the pipeline of paper 002 (global model, confirmation, local refinement) — for smooth landscapes;
 #: ``"sparse-global"``: the same lines and blend made global on multimodal ones (basins of the blend and of its
@@ -128,7 +128,7 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
     """
     _check_arguments(problem, budget, method, seed, workers, store)
     X0 = check_x0(problem, x0, int(budget))
-    opts = _checked_options(problem, method, options, int(budget), int(seed), X0)
+    opts = checked_options(problem, method, options, int(budget), int(seed), X0)
     log = log or (lambda _line: None)
     t0 = time.perf_counter()
     with contextlib.ExitStack() as stack:
@@ -180,11 +180,12 @@ def _options(problem: DesignProblem, options: Mapping[str, Any] | SparseOptions 
     return SparseOptions.for_budget(budget, problem.dim, seed, **given)
 
 
-def _checked_options(problem: DesignProblem, method: str | Callable[..., Any],
-                     options: Mapping[str, Any] | SparseOptions | None, budget: int, seed: int,
-                     x0: np.ndarray | None = None) -> SparseOptions:
+def checked_options(problem: DesignProblem, method: str | Callable[..., Any],
+                    options: Mapping[str, Any] | SparseOptions | None, budget: int, seed: int,
+                    x0: np.ndarray | None = None) -> SparseOptions:
     """The options of :func:`_options` for what ``x0`` leaves of the budget; a budget below the method's minimum is
-    refused on them, since the sparse method's minimum depends on its lines, which the options may set."""
+    refused on them, since the sparse method's minimum depends on its lines, which the options may set (shared with
+    ``mechopt study --x0``)."""
     m = 0 if x0 is None else x0.shape[0]
     opts = _options(problem, options, budget - m, seed)
     try:

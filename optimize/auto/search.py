@@ -8,6 +8,7 @@ step together; the budget is spent exactly, on distinct designs only.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -398,13 +399,13 @@ def auto_search(evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, seed:
     run = _Run(evaluate, bounds, int(budget), feasible, np.random.default_rng(seed), margins, residuals)
     run.prior = plan.name == "trust-region"
     with _limited_threads():
-        n_init = plan.n_init
+        n_init, n_x0 = plan.n_init, 0
         if initial is not None and len(initial):
             U0 = (np.atleast_2d(np.asarray(initial, dtype=float)) - run.lo) / run.width
             # Only designs inside the box: the line plan's reach beyond it, clipped onto a face, would be new designs
             # simulated on top of the budget (7 of 9 of a ventilator plan of 3 lines were).
             U0 = np.clip(U0[np.all((U0 >= -1e-9) & (U0 <= 1.0 + 1e-9), axis=1)], 0.0, 1.0)
-            run.budget += U0.shape[0]
+            run.budget, n_x0 = run.budget + U0.shape[0], U0.shape[0]
             run.simulate(U0)
             n_init = max(0, n_init - int(run.ok.sum()))
         run.simulate(_initial_design(run, n_init))
@@ -420,5 +421,8 @@ def auto_search(evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, seed:
         x, fun = run.to_x(run.U[i]), float(run.values[i])
     else:
         x, fun = np.full(d, np.nan), float("nan")
-    message = f"{plan.describe(d, int(budget))}; {run.values.size} simulations, {nfailed} failed"
+    # With x0, its designs stand in for as many Sobol designs (and the budget is the method's share).
+    said = plan if not n_x0 else dataclasses.replace(plan, n_init=n_init)
+    message = (f"{said.describe(d, int(budget))}" + (f", after the {n_x0} designs of x0" if n_x0 else "")
+               + f"; {run.values.size} simulations, {nfailed} failed")
     return AutoResult(x, fun, int(run.values.size), nfailed, plan, message, run.to_x(run.U), run.values)

@@ -3,6 +3,7 @@ own one-line messages."""
 
 import json
 
+import numpy as np
 import pytest
 
 import mechopt
@@ -51,9 +52,26 @@ def test_study_runs_a_chosen_method(tmp_path, capsys):
     assert "method differential_evolution" in capsys.readouterr().out
 
 
+def test_study_starts_from_x0_as_the_api_does(tmp_path, capsys):
+    out = tmp_path / "h3"
+    x0 = [[0.1, 0.55, 0.85], [0.2, 0.5, 0.8]]
+    assert main(["study", "hartmann3", "--method", "auto", "--budget", "12", "--x0", "0.1,0.55,0.85", "--x0",
+                 "0.2,0.5,0.8", "--lines", "0", "--workers", "1", "--no-progress", "--out", str(out)]) == 0
+    result = json.loads((out / "result.json").read_text())
+    assert result["simulations"]["optimisation"] == 12  # x0 counts in the budget
+    api = mechopt.minimize(Hartmann3(), budget=12, method="auto", seed=0, x0=x0)
+    assert result["optimum"]["objective"] == pytest.approx(api.fun, rel=0, abs=0)
+    assert api.fun <= Hartmann3().function(np.array(x0)).min() + 1e-12  # never worse than x0
+    printed = capsys.readouterr().out
+    assert "x0: 2 design(s) simulated first, counted in the budget of 12 (the method has 10)" in printed
+    assert "6 Sobol designs" in printed and "after the 2 designs of x0" in printed
+
+
 @pytest.mark.parametrize(("argv", "call"), [
     (["--budget", "1"], {"budget": 1}),
     (["--method", "no_such_method"], {"method": "no_such_method"}),
+    (["--x0", "0.1,0.2"], {"x0": [0.1, 0.2]}),
+    (["--x0", "1.5,0.5,0.5"], {"x0": [1.5, 0.5, 0.5]}),
 ])
 def test_cli_and_api_refuse_the_same_arguments_with_the_same_message(tmp_path, capsys, argv, call):
     code = main(["study", "hartmann3", "--lines", "0", "--no-progress", "--out", str(tmp_path / "x"), *argv])
