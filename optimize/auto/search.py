@@ -8,9 +8,8 @@ step together; the budget is spent exactly, on distinct designs only.
 from __future__ import annotations
 
 import contextlib
-import dataclasses
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -422,7 +421,7 @@ def auto_search(evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, seed:
     else:
         x, fun = np.full(d, np.nan), float("nan")
     # With x0, its designs stand in for as many Sobol designs (and the budget is the method's share).
-    said = plan if not n_x0 else dataclasses.replace(plan, n_init=n_init)
+    said = plan if not n_x0 else replace(plan, n_init=n_init)
     message = (f"{said.describe(d, int(budget))}" + (f", after the {n_x0} designs of x0" if n_x0 else "")
                + f"; {run.values.size} simulations, {nfailed} failed")
     return AutoResult(x, fun, int(run.values.size), nfailed, plan, message, run.to_x(run.U), run.values)
