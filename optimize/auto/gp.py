@@ -1,5 +1,19 @@
-"""A Gaussian process on the unit cube: Matérn-5/2 kernel with one length-scale per variable, hyperparameters by
-maximum marginal likelihood (ML-II), optionally with a weak prior, several starts.
+"""A Gaussian process on the unit cube: a Matérn-5/2 kernel with one length-scale per variable plus a first-order
+additive component, hyperparameters by maximum marginal likelihood (ML-II), optionally with a weak prior, several
+starts.
+
+The additive component (Duvenaud, Nickisch & Rasmussen 2011, first order) is the mean over the variables of a
+one-variable Matérn-5/2 with the same length-scales, with a variance of its own; the evidence shares the prior
+variance between the two components.  Where the objective is a sum of one contribution per variable (or nearly:
+a sum of terms, a separable well in each variable), the model then predicts a combination of the variables no
+design has from what each variable did elsewhere: a variable left in the wrong one of its wells is seen to be
+wrong.  The product kernel alone cannot, and expects nothing from a move it has not sampled near.  Where the
+variables interact, the evidence gives the additive component (nearly) nothing, and the model is the product's.
+Measured with ``benchmarks/bench_default.py`` (20 seeds; BENCHMARKS.md), median gap at 30 simulations before ->
+after: Styblinski-Tang-3 3.3 -> 0.099 % (the global well in 16 seeds instead of 6), Hartmann-4 0.37 -> 0.064 %,
+cosine_bowl4 9.8 -> 7.7 %, Hartmann-3 0.0020 -> 0.00067 %; cosine_bowl3 0.044 -> 0.81 % (its global basin in 11
+seeds instead of 15: a bowl, additive, under a product of cosines, which is not).  A component the evidence gives
+under 1e-3 of the product's variance is left out of the fitted model, which then costs what the product alone does.
 
 The prior mean is a constant estimated by generalised least squares at the fitted hyperparameters (ordinary
 kriging's mean, the model of DACE and of EGO: Jones, Schonlau & Welch 1998; BoTorch's constant mean fitted by
@@ -28,6 +42,8 @@ import numpy as np
 from scipy.linalg import cho_solve, solve_triangular
 from scipy.optimize import minimize
 
+from mechopt.optimize.auto.additive_kernel import additive_gradient, additive_gram, additive_matern
+
 __all__ = ["GaussianProcess", "fit_gp"]
 
 _SQRT5 = math.sqrt(5.0)
@@ -39,6 +55,11 @@ _LOG_SIGNAL = (math.log(0.05), math.log(20.0))
 #: standardised variance smoothed away what the designs around a minimum had resolved (Rosenbrock-6 at 300
 #: simulations ended at a median 2.50 in a valley the model could no longer see down; 0.67 with this floor).
 _LOG_NOISE = (math.log(1e-10), math.log(0.1))
+#: Bounds of the log variance of the additive component (standardised targets), and its start.
+_LOG_ADDITIVE = (math.log(1e-4), math.log(20.0))
+_LOG_ADDITIVE_START = math.log(0.1)
+#: Log of the share of the product's variance below which the additive component is left out of a fitted model.
+_NEGLIGIBLE = math.log(1e-3)
 #: Jitter added, in turn, to the diagonal of a covariance matrix whose factorisation failed (fraction of the signal).
 _JITTER = (0.0, 1e-10, 1e-8, 1e-6, 1e-4)
 
@@ -52,6 +73,24 @@ def _matern(U: np.ndarray, V: np.ndarray, ell: np.ndarray, signal: float) -> tup
     K = signal * (1.0 + _SQRT5 * r + 5.0 / 3.0 * r2) * e
     W = signal * 5.0 / 3.0 * (1.0 + _SQRT5 * r) * e
     return K, W
+
+
+def _additive(U: np.ndarray, V: np.ndarray, ell: np.ndarray, variance: float) -> np.ndarray:
+    """First-order additive covariance of designs U (n, d) and V (m, d): ``variance`` times the mean over the
+    variables of a one-variable Matérn-5/2."""
+    K = additive_matern(np.ascontiguousarray(U, dtype=float), np.ascontiguousarray(V, dtype=float), ell)
+    return variance / U.shape[1] * K
+
+
+def _covariance(U: np.ndarray, V: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """Covariance of designs U and V under ``theta``: the Matérn product, plus the additive component when
+    ``theta`` has its variance (d + 3 entries)."""
+    d = U.shape[1]
+    ell = np.exp(theta[:d])
+    K, _ = _matern(U, V, ell, math.exp(theta[d]))
+    if theta.size > d + 2:
+        K = K + _additive(U, V, ell, math.exp(theta[d + 2]))
+    return K
 
 
 def _cholesky(K: np.ndarray, signal: float) -> np.ndarray:
@@ -78,8 +117,9 @@ class GaussianProcess:
         Designs in the unit cube.
     y : (n,) ndarray
         Standardised targets.
-    theta : (d + 2,) ndarray
-        log length-scales, log signal variance, log noise variance.
+    theta : (d + 2,) or (d + 3,) ndarray
+        log length-scales, log signal variance (the product kernel's), log noise variance and, with d + 3 entries,
+        the additive component's log variance.
     """
 
     def __init__(self, X: np.ndarray, y: np.ndarray, theta: np.ndarray) -> None:
@@ -87,7 +127,10 @@ class GaussianProcess:
         d = self.X.shape[1]
         self.ell = np.exp(self.theta[:d])
         self.signal, self.noise = math.exp(self.theta[d]), math.exp(self.theta[d + 1])
-        K, _ = _matern(self.X, self.X, self.ell, self.signal)
+        if self.theta.size > d + 2:
+            # The prior variance of f: the product's and the additive component's.
+            self.signal += math.exp(self.theta[d + 2])
+        K = _covariance(self.X, self.X, self.theta)
         K[np.diag_indices_from(K)] += self.noise
         self.L = _cholesky(K, self.signal)
         k1 = cho_solve((self.L, True), np.ones(self.y.size))
@@ -98,7 +141,7 @@ class GaussianProcess:
     def predict(self, U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Posterior mean and standard deviation (of the latent function, no noise) at designs U (m, d), the mean
         level taken as known."""
-        Ks, _ = _matern(np.atleast_2d(U), self.X, self.ell, self.signal)
+        Ks = _covariance(np.atleast_2d(U), self.X, self.theta)
         mean = self.mean_level + Ks @ self.alpha
         V = solve_triangular(self.L, Ks.T, lower=True)
         var = np.maximum(self.signal - np.sum(V * V, axis=0), 1e-12 * self.signal)
@@ -107,8 +150,8 @@ class GaussianProcess:
     def draw(self, U: np.ndarray, n: int, rng: np.random.Generator) -> np.ndarray:
         """``n`` joint draws (n, m) of the latent function at designs U (m, d) from the posterior."""
         U = np.atleast_2d(U)
-        Ks, _ = _matern(U, self.X, self.ell, self.signal)
-        Kss, _ = _matern(U, U, self.ell, self.signal)
+        Ks = _covariance(U, self.X, self.theta)
+        Kss = _covariance(U, U, self.theta)
         V = solve_triangular(self.L, Ks.T, lower=True)
         C = Kss - V.T @ V
         try:
@@ -132,7 +175,11 @@ def _neg_log_posterior(theta: np.ndarray, X: np.ndarray, y: np.ndarray, prior_mu
     n, d = X.shape
     ell, signal, noise = np.exp(theta[:d]), math.exp(theta[d]), math.exp(theta[d + 1])
     K, W = _matern(X, X, ell, signal)
-    Kf = K.copy()
+    Kp = K.copy()
+    additive = theta.size > d + 2
+    if additive:
+        Ka = math.exp(theta[d + 2]) / d * additive_gram(np.ascontiguousarray(X), ell)
+        K += Ka
     K[np.diag_indices_from(K)] += noise
     try:
         L = np.linalg.cholesky(K)
@@ -149,10 +196,13 @@ def _neg_log_posterior(theta: np.ndarray, X: np.ndarray, y: np.ndarray, prior_mu
     U = X / ell
     # Σ_ij M_ij (u_ik − u_jk)² without forming the n × n × d differences.
     grad_ell = -0.5 * (2.0 * np.sum(U * U * M.sum(1)[:, None], 0) - 2.0 * np.sum(U * (M @ U), 0))
-    grad = np.concatenate([grad_ell, [-0.5 * np.sum(A * Kf), -0.5 * noise * np.trace(A)]])
+    grad = np.concatenate([grad_ell, [-0.5 * np.sum(A * Kp), -0.5 * noise * np.trace(A)]])
+    if additive:
+        grad[:d] -= 0.5 * math.exp(theta[d + 2]) / d * additive_gradient(np.ascontiguousarray(X), ell, A)
+        grad = np.concatenate([grad, [-0.5 * np.sum(A * Ka)]])
     # Log-normal prior on the length-scales, variance 3 (weight w: 1 with the prior, 0 for plain ML-II).
     z = theta[:d] - prior_mu
-    return float(nll + w * np.sum(z * z) / 6.0), grad + w * np.concatenate([z / 3.0, [0.0, 0.0]])
+    return float(nll + w * np.sum(z * z) / 6.0), grad + w * np.concatenate([z / 3.0, np.zeros(theta.size - d)])
 
 
 def fit_gp(X: np.ndarray, y: np.ndarray, rng: np.random.Generator, warm: np.ndarray | None = None,
@@ -178,16 +228,23 @@ def fit_gp(X: np.ndarray, y: np.ndarray, rng: np.random.Generator, warm: np.ndar
     """
     d = X.shape[1]
     prior_mu = math.sqrt(2.0) + 0.5 * math.log(d)
-    bounds = [_LOG_ELL] * d + [_LOG_SIGNAL, _LOG_NOISE]
+    bounds = [_LOG_ELL] * d + [_LOG_SIGNAL, _LOG_NOISE, _LOG_ADDITIVE]
     lo, hi = np.array(bounds).T
+    if warm is not None and warm.size == d + 2:
+        # The previous fit left the additive component out (below): it restarts from where it was left.
+        warm = np.append(warm, _LOG_ADDITIVE[0])
     cands = [] if warm is None else [np.clip(warm, lo, hi)]
     while len(cands) < max(starts, 1):
         ell = np.clip(prior_mu + math.sqrt(3.0) * rng.standard_normal(d), *_LOG_ELL)
-        cands.append(np.concatenate([ell, [0.0, math.log(1e-4)]]))
+        cands.append(np.concatenate([ell, [0.0, math.log(1e-4), _LOG_ADDITIVE_START]]))
     best, best_val = cands[0], np.inf
     for theta0 in cands:
         res = minimize(_neg_log_posterior, theta0, args=(X, y, prior_mu, float(prior)), jac=True, method="L-BFGS-B",
                        bounds=bounds, options={"maxiter": maxiter})
         if res.fun < best_val:
             best, best_val = res.x, res.fun
+    if best[d + 2] < best[d] + _NEGLIGIBLE:
+        # The evidence gave the additive component (next to) nothing: the model is the product kernel's, and
+        # predicting without the component's d exponentials a pair of designs halves the acquisition's cost.
+        best = best[: d + 2]
     return GaussianProcess(X, y, best)

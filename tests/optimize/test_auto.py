@@ -188,17 +188,38 @@ def test_gp_gradient_and_fit():
     X = rng.random((25, 3))
     y = np.sin(6 * X[:, 0]) + X[:, 1] ** 2
     y = (y - y.mean()) / y.std()
-    theta = np.array([-1.0, -0.3, 0.5, 0.2, np.log(1e-3)])
-    for w in (0.0, 1.0):
-        grad = _neg_log_posterior(theta, X, y, 1.9, w)[1]
-        fd = approx_fprime(theta, lambda t, w=w: _neg_log_posterior(t, X, y, 1.9, w)[0], 1e-6)
-        np.testing.assert_allclose(grad, fd, rtol=1e-4, atol=1e-4)
+    # Without and with the additive component's variance (the last entry).
+    for theta in (np.array([-1.0, -0.3, 0.5, 0.2, np.log(1e-3)]), np.array([-1.0, -0.3, 0.5, 0.2, -7.0, -0.7])):
+        for w in (0.0, 1.0):
+            grad = _neg_log_posterior(theta, X, y, 1.9, w)[1]
+            fd = approx_fprime(theta, lambda t, w=w: _neg_log_posterior(t, X, y, 1.9, w)[0], 1e-6)
+            np.testing.assert_allclose(grad, fd, rtol=1e-4, atol=1e-4)
     gp = fit_gp(X, y, rng)
     mean, sd = gp.predict(X)
     np.testing.assert_allclose(mean, y, atol=0.05)  # a near-noiseless function is interpolated
     assert np.all(sd < 0.1)
     # x3 does not enter y: its length-scale is the longest.
     assert np.argmax(gp.theta[:3]) == 2
+
+
+def test_an_additive_function_is_told_from_an_interaction_by_the_evidence():
+    # f = g1(x1) + g2(x2) + g3(x3): the evidence puts the variance on the additive component, and the model then
+    # predicts combinations of the variables no design has, from what each variable did elsewhere.  A product of
+    # the same three terms gets it on the product (Matérn) component, and the additive one is left out.
+    rng = np.random.default_rng(1)
+    X, U = rng.random((30, 3)), rng.random((500, 3))
+    terms = lambda X: (np.sin(6 * X[:, 0]), np.cos(5 * X[:, 1]), 2.0 * X[:, 2] ** 2)  # noqa: E731
+    for combine, additive in ((lambda t: t[0] + t[1] + t[2], True), (lambda t: t[0] * t[1] * t[2], False)):
+        y, truth = combine(terms(X)), combine(terms(U))
+        scale, level = y.std(), y.mean()
+        gp = fit_gp(X, (y - level) / scale, rng, prior=False)
+        if not additive:
+            assert gp.theta.size == 5  # the component left out of the model: the product kernel alone
+        else:
+            share = np.exp(gp.theta[5]) / (np.exp(gp.theta[5]) + np.exp(gp.theta[3]))  # additive / total
+            assert share > 0.95
+            error = gp.predict(U)[0] * scale + level - truth
+            assert np.max(np.abs(error)) < 0.05 * np.ptp(truth)
 
 
 def test_a_deterministic_function_is_interpolated_to_its_resolution():
@@ -210,7 +231,7 @@ def test_a_deterministic_function_is_interpolated_to_its_resolution():
     y = (X[:, 0] - 0.3) ** 2 + 2.0 * (X[:, 1] - 0.6) ** 2 + 0.3 * np.sin(5.0 * X[:, 0])
     y = (y - y.mean()) / y.std()
     gp = fit_gp(X, y, rng, prior=False)
-    assert np.exp(gp.theta[-1]) < 1e-8
+    assert np.exp(gp.theta[3]) < 1e-8  # the noise variance (d + 1)
     np.testing.assert_allclose(gp.predict(X)[0], y, atol=1e-6)
 
 
@@ -272,3 +293,24 @@ def test_the_ventilator_at_20_leaves_the_vertex_of_the_toggle_margin_and_bc_lowe
     problem = load_study("ventilator", {"engine": "analytic"}).problem
     r = minimize(problem, 20, method="auto", seed=6)
     assert r.fun == pytest.approx(1.7582, rel=3e-4)
+
+
+def test_additive_kernel_matches_its_closed_form_inside_and_far_outside_the_cube():
+    from mechopt.optimize.auto.additive_kernel import additive_gradient, additive_gram, additive_matern
+
+    def direct(U, V, ell):
+        S = np.sqrt(5.0) * np.abs(U[:, None, :] - V[None, :, :]) / ell
+        E = np.exp(-S)
+        return np.sum((1.0 + S + S * S / 3.0) * E, axis=2), np.moveaxis(S * S / 3.0 * (1.0 + S) * E, 2, 0)
+
+    rng = np.random.default_rng(2)
+    X, ell = rng.random((12, 3)), np.array([0.3, 0.05, 2.0])
+    # Far outside the unit cube with a length-scale at its lower bound the per-design exponentials would overflow.
+    U = np.vstack([rng.random((5, 3)), [[3.0, -2.0, 0.5]]])
+    for ell_used in (ell, np.array([0.3, 5e-3, 2.0])):
+        np.testing.assert_allclose(additive_matern(U, X, ell_used), direct(U, X, ell_used)[0], rtol=1e-12, atol=1e-14)
+    K, G = direct(X, X, ell)
+    np.testing.assert_allclose(additive_gram(X, ell), K, rtol=1e-12)
+    W = rng.standard_normal((12, 12))
+    W = W + W.T
+    np.testing.assert_allclose(additive_gradient(X, ell, W), np.einsum("ij,kij->k", W, G), rtol=1e-10)
