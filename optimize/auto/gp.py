@@ -245,6 +245,7 @@ def fit_gp(X: np.ndarray, y: np.ndarray, rng: np.random.Generator, warm: np.ndar
             best, best_val = res.x, res.fun
     if best[d + 2] < best[d] + _NEGLIGIBLE:
         # The evidence gave the additive component (next to) nothing: the model is the product kernel's, and
-        # predicting without the component's d exponentials a pair of designs halves the acquisition's cost.
+        # predicting without the component's d terms a pair of designs is cheaper (Hartmann-6 at 300 simulations:
+        # 55 s of the method's own time instead of 65 s).
         best = best[: d + 2]
     return GaussianProcess(X, y, best)
