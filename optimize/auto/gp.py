@@ -125,7 +125,6 @@ class GaussianProcess:
     def __init__(self, X: np.ndarray, y: np.ndarray, theta: np.ndarray) -> None:
         self.X, self.y, self.theta = np.asarray(X, float), np.asarray(y, float), np.asarray(theta, float)
         d = self.X.shape[1]
-        self.ell = np.exp(self.theta[:d])
         self.signal, self.noise = math.exp(self.theta[d]), math.exp(self.theta[d + 1])
         if self.theta.size > d + 2:
             # The prior variance of f: the product's and the additive component's.
@@ -178,7 +177,9 @@ def _neg_log_posterior(theta: np.ndarray, X: np.ndarray, y: np.ndarray, prior_mu
     Kp = K.copy()
     additive = theta.size > d + 2
     if additive:
-        Ka = math.exp(theta[d + 2]) / d * additive_gram(np.ascontiguousarray(X), ell)
+        # The component's weight: its variance over the d terms it averages.
+        weight, Xc = math.exp(theta[d + 2]) / d, np.ascontiguousarray(X)
+        Ka = weight * additive_gram(Xc, ell)
         K += Ka
     K[np.diag_indices_from(K)] += noise
     try:
@@ -198,7 +199,7 @@ def _neg_log_posterior(theta: np.ndarray, X: np.ndarray, y: np.ndarray, prior_mu
     grad_ell = -0.5 * (2.0 * np.sum(U * U * M.sum(1)[:, None], 0) - 2.0 * np.sum(U * (M @ U), 0))
     grad = np.concatenate([grad_ell, [-0.5 * np.sum(A * Kp), -0.5 * noise * np.trace(A)]])
     if additive:
-        grad[:d] -= 0.5 * math.exp(theta[d + 2]) / d * additive_gradient(np.ascontiguousarray(X), ell, A)
+        grad[:d] -= 0.5 * weight * additive_gradient(Xc, ell, A)
         grad = np.concatenate([grad, [-0.5 * np.sum(A * Ka)]])
     # Log-normal prior on the length-scales, variance 3 (weight w: 1 with the prior, 0 for plain ML-II).
     z = theta[:d] - prior_mu
