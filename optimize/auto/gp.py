@@ -176,12 +176,15 @@ class GaussianProcess:
 
 
 def _inverse(L: np.ndarray) -> np.ndarray:
-    """K⁻¹ from the lower Cholesky factor L of K: LAPACK's ``potri`` (a triangular inverse and one product), a third
-    of the time of solving for the identity's n columns, which was a sixth of the method's own time at 6-D."""
+    """K⁻¹ from the lower Cholesky factor L of K by LAPACK's ``potri`` (a triangular inverse and one product).
+
+    Solving for the identity's n columns took about a sixth of the method's own time at 6-D; ``potri`` takes a little
+    over half as long (an ad hoc timing, 150 designs, one thread: 0.53 ms against 0.92 ms).
+    """
     inv, info = dpotri(L, lower=1)
     if info:
         raise np.linalg.LinAlgError(f"potri failed with info {info}")
-    # potri fills the lower triangle only; mirrored in place (np.tril + its transpose took twice as long).
+    # potri fills the lower triangle only; mirrored in place (np.tril plus its transpose took twice as long, ad hoc).
     inv = np.tril(inv)
     inv += inv.T
     inv[np.diag_indices_from(inv)] *= 0.5
