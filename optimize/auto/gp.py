@@ -84,7 +84,9 @@ def _matern(U: np.ndarray, V: np.ndarray, ell: np.ndarray, signal: float) -> tup
 def _additive(U: np.ndarray, V: np.ndarray, ell: np.ndarray, variance: float) -> np.ndarray:
     """First-order additive covariance of designs U (n, d) and V (m, d): ``variance`` times the mean over the
     variables of a one-variable Matérn-5/2."""
-    K = additive_matern(np.ascontiguousarray(U, dtype=float), np.ascontiguousarray(V, dtype=float), ell)
+    symmetric, U = V is U, np.ascontiguousarray(U, dtype=float)
+    # The designs' own covariance (a fit's, a batch's draws): each pair once, the same numbers.
+    K = additive_gram(U, ell) if symmetric else additive_matern(U, np.ascontiguousarray(V, dtype=float), ell)
     return variance / U.shape[1] * K
 
 
