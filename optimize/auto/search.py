@@ -187,7 +187,11 @@ class _Run:
         """
         idx = np.arange(self.values.size) if idx is None else idx
         values = self.values[idx]
-        worst = np.nanmax(values) if np.isfinite(values).any() else np.nanmax(self.values)
+        # The worst finite value: an objective of +inf (a design the user's objective rejects) fails as NaN does,
+        # and must not become the target that standardising turns into NaN.
+        finite = values[np.isfinite(values)]
+        finite = finite if finite.size else self.values[self.ok]
+        worst = float(finite.max()) if finite.size else 0.0
         y = standardise(np.where(np.isfinite(values), values, worst), compress_tail=self.prior)
         full = self.theta is None or idx.size >= 1.25 * self.n_full_fit
         if full:
@@ -409,7 +413,13 @@ def auto_search(evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, seed:
             n_init = max(0, n_init - int(run.ok.sum()))
         run.simulate(_initial_design(run, n_init))
         if run.ok.sum() < 2 and plan.name != "least-squares":
-            run.simulate(_initial_design(run, run.remaining))
+            # Too few successes to fit a model: more space-filling designs, a batch at a time, only until two
+            # succeed (a simulator that fails in most of the box must not turn the whole budget into a Sobol design).
+            more = _initial_design(run, run.remaining)
+            for start in range(0, more.shape[0], plan.batch):
+                if run.ok.sum() >= 2:
+                    break
+                run.simulate(more[start: start + plan.batch])
         if plan.name == "least-squares":
             least_squares_plan(run, plan.batch, fd_step, run.unit_margins)
         else:
