@@ -157,8 +157,6 @@ def run_dask(args: argparse.Namespace, folder: Path) -> list[dict]:
     rows = []
     with LocalCluster(n_workers=2, threads_per_worker=4, processes=True, dashboard_address=None) as cluster:
         for method in args.methods:
-            if method == "auto":
-                continue
             row = timed(folder, args.functions[0], method, 60, 8, args.seed, args.sleep, scheduler=cluster)
             row["workers"] = "Dask 2×4"
             rows.append(row)

@@ -1,4 +1,4 @@
-"""Issue 28: every phase of the sparse methods proposes as many designs at once as there are workers.
+"""Issue 28: every phase of the mechopt methods proposes as many designs at once as there are workers.
 
 A real Dask ``LocalCluster`` runs a real subprocess simulator (an external-command study): the designs go out in
 batches (fewer rounds than simulations), and the results equal those of the same batch size in-process (the method
@@ -75,7 +75,7 @@ def _in_process(problem, method: str, budget: int, workers: int, tmp_path):
         return res, sampler
 
 
-@pytest.mark.parametrize("method", ["sparse", "sparse-global"])
+@pytest.mark.parametrize("method", ["sparse", "sparse-global", "auto"])
 def test_a_dask_cluster_gets_batches_and_the_answer_of_the_same_batch_in_process(command_problem, cluster, method,
                                                                                  tmp_path):
     res = minimize(command_problem, budget=30, method=method, seed=0, workers=None, scheduler=cluster)
