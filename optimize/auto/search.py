@@ -420,7 +420,10 @@ def auto_search(evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, seed:
                 if run.ok.sum() >= 2:
                     break
                 run.simulate(more[start: start + plan.batch])
-        if plan.name == "least-squares":
+        if not run.values.size:
+            # No design of the thousands tried satisfies the declared constraints: nothing to model (said below).
+            pass
+        elif plan.name == "least-squares":
             least_squares_plan(run, plan.batch, fd_step, run.unit_margins)
         else:
             (_global_plan if plan.name == "global" else _trust_region_plan)(run, plan)
@@ -433,5 +436,6 @@ def auto_search(evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, seed:
     # With x0, its designs stand in for as many Sobol designs (and the budget is the method's share).
     said = plan if not n_x0 else replace(plan, n_init=n_init)
     message = (f"{said.describe(d, int(budget))}" + (f", after the {n_x0} designs of x0" if n_x0 else "")
-               + f"; {run.values.size} simulations, {nfailed} failed")
+               + f"; {run.values.size} simulations, {nfailed} failed"
+               + ("" if run.values.size else "; no design tried satisfies the declared constraints"))
     return AutoResult(x, fun, int(run.values.size), nfailed, plan, message, run.to_x(run.U), run.values)

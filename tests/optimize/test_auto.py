@@ -184,6 +184,17 @@ def test_budget_below_2d_plus_2_refused_in_one_line():
     assert "2d + 2 = 14" in str(info.value) and "\n" not in str(info.value)
 
 
+def test_no_design_satisfying_the_constraints_ends_the_search_with_the_reason():
+    # minimize refuses such a problem before it starts (DesignProblem.check_region); the search itself, given one,
+    # says why it simulated nothing instead of fitting a model to no designs.
+    from mechopt.optimize.auto.search import auto_search
+
+    r = auto_search(lambda X: np.sum(X * X, axis=1), np.array([[0.0, 1.0]] * 3), 20, seed=0,
+                    feasible=lambda X: np.zeros(len(X), dtype=bool))
+    assert r.nfev == 0 and np.isnan(r.fun) and np.isnan(r.x).all()
+    assert r.message.endswith("no design tried satisfies the declared constraints")
+
+
 def test_gp_gradient_and_fit():
     rng = np.random.default_rng(0)
     X = rng.random((25, 3))
