@@ -420,12 +420,10 @@ def auto_search(evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, seed:
                 if run.ok.sum() >= 2:
                     break
                 run.simulate(more[start: start + plan.batch])
-        if not run.values.size:
-            # No design of the thousands tried satisfies the declared constraints: nothing to model (said below).
-            pass
-        elif plan.name == "least-squares":
+        # No design at all: none of the thousands tried satisfies the declared constraints (said in the message).
+        if run.values.size and plan.name == "least-squares":
             least_squares_plan(run, plan.batch, fd_step, run.unit_margins)
-        else:
+        elif run.values.size:
             (_global_plan if plan.name == "global" else _trust_region_plan)(run, plan)
     nfailed = int((~run.ok).sum())
     if run.ok.any():
