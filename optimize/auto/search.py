@@ -196,8 +196,9 @@ class _Run:
         full = self.theta is None or idx.size >= 1.25 * self.n_full_fit
         if full:
             self.n_full_fit = idx.size
+        # The global plan (no length-scale prior) starts from a few designs whose evidence may see white noise.
         gp = fit_gp(self.U[idx], y, self.rng, warm=self.theta, starts=3 if full else 1, maxiter=100 if full else 30,
-                    prior=self.prior)
+                    prior=self.prior, spacing_floor=not self.prior)
         self.theta = gp.theta
         return gp, float(y.min())
 

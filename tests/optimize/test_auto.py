@@ -5,13 +5,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from scipy.optimize import approx_fprime
+from scipy.stats import qmc
 
 from mechopt import minimize
 from mechopt.errors import InputError
 from mechopt.optimize.auto import auto_search, choose_plan
-from mechopt.optimize.auto.gp import GaussianProcess, _neg_log_posterior, fit_gp
+from mechopt.optimize.auto.gp import GaussianProcess, _median_spacing, _neg_log_posterior, _sees_no_neighbour, fit_gp
+from mechopt.optimize.auto.transform import standardise
 from mechopt.optimize.problem import DesignProblem, Variable
-from mechopt.studies.test_functions import FailingHartmann3, Hartmann3, Hartmann6
+from mechopt.studies.test_functions import SUITE, FailingHartmann3, Hartmann3, Hartmann6
 
 
 class Quadratic(DesignProblem):
@@ -337,3 +339,29 @@ def test_additive_kernel_matches_its_closed_form_inside_and_far_outside_the_cube
     W = rng.standard_normal((12, 12))
     W = W + W.T
     np.testing.assert_allclose(additive_gradient(X, ell, W), np.einsum("ij,kij->k", W, G), rtol=1e-10)
+
+
+def test_a_fit_that_sees_white_noise_is_refitted_at_the_designs_spacing():
+    # Eight Sobol designs of cosine_bowl3 look uncorrelated to the marginal likelihood, which puts every
+    # length-scale on its lower bound: a model of white noise, flat expected improvement.  With the floor the fit
+    # is redone with no length-scale below half the designs' median nearest-neighbour distance.
+    X = qmc.Sobol(3, seed=7).random(8)
+    y = standardise(SUITE["cosine_bowl3"]().function(X), compress_tail=False)
+    plain = fit_gp(X, y, np.random.default_rng(0), prior=False)
+    assert np.allclose(np.exp(plain.theta[:3]), 5e-3) and _sees_no_neighbour(plain)
+    floored = fit_gp(X, y, np.random.default_rng(0), prior=False, spacing_floor=True)
+    assert np.all(np.exp(floored.theta[:3]) >= 0.5 * _median_spacing(X) * (1 - 1e-9))
+    assert not _sees_no_neighbour(floored)
+    # The median spacing of the designs, by hand for three of them on a line.
+    assert _median_spacing(np.array([[0.0, 0.0], [0.1, 0.0], [0.4, 0.0]])) == pytest.approx(0.1)
+
+
+def test_a_fit_that_sees_its_neighbours_is_left_alone_by_the_floor():
+    rng = np.random.default_rng(4)
+    X = rng.random((20, 2))
+    y = (X[:, 0] - 0.3) ** 2 + np.sin(4.0 * X[:, 1])
+    y = (y - y.mean()) / y.std()
+    plain = fit_gp(X, y, np.random.default_rng(0), prior=False)
+    assert not _sees_no_neighbour(plain)
+    floored = fit_gp(X, y, np.random.default_rng(0), prior=False, spacing_floor=True)
+    np.testing.assert_array_equal(floored.theta, plain.theta)
