@@ -139,7 +139,9 @@ class GaussianProcess:
         if self.theta.size > d + 2:
             # The prior variance of f: the product's and the additive component's.
             self.signal += math.exp(self.theta[d + 2])
-        K = _covariance(self.X, self.X, self.theta)
+        #: The designs' prior covariance (no noise), kept for :func:`_sees_no_neighbour`.
+        self.K = _covariance(self.X, self.X, self.theta)
+        K = self.K.copy()
         K[np.diag_indices_from(K)] += self.noise
         self.L = _cholesky(K, self.signal)
         k1 = cho_solve((self.L, True), np.ones(self.y.size), check_finite=False)
@@ -286,8 +288,7 @@ def _median_spacing(X: np.ndarray) -> float:
 
 def _sees_no_neighbour(gp: GaussianProcess) -> bool:
     """Whether the median design's correlation with its nearest neighbour under ``gp``'s kernel is below 0.05."""
-    K = _covariance(gp.X, gp.X, gp.theta)
-    C = K / K[0, 0]
+    C = gp.K / gp.K[0, 0]
     np.fill_diagonal(C, -np.inf)
     return bool(np.median(C.max(axis=1)) < _NO_NEIGHBOUR)
 

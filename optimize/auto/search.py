@@ -422,10 +422,11 @@ def auto_search(evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, seed:
                     break
                 run.simulate(more[start: start + plan.batch])
         # No design at all: none of the thousands tried satisfies the declared constraints (said in the message).
-        if run.values.size and plan.name == "least-squares":
-            least_squares_plan(run, plan.batch, fd_step, run.unit_margins)
-        elif run.values.size:
-            (_global_plan if plan.name == "global" else _trust_region_plan)(run, plan)
+        if run.values.size:
+            if plan.name == "least-squares":
+                least_squares_plan(run, plan.batch, fd_step, run.unit_margins)
+            else:
+                (_global_plan if plan.name == "global" else _trust_region_plan)(run, plan)
     nfailed = int((~run.ok).sum())
     if run.ok.any():
         i = run.best_index()
