@@ -13,6 +13,7 @@ search, which then starts next to the optimum.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -327,7 +328,11 @@ def residual_model(U: np.ndarray, residual: np.ndarray,
     """
     for degree in (1, 0):
         try:
-            return RBFInterpolator(U, residual, kernel=kernel, degree=degree, smoothing=1e-10)
+            with warnings.catch_warnings():
+                # scipy warns that a cubic kernel wants at least a linear tail; the constant one is the fallback
+                # for designs that cannot carry a plane, and the tiny smoothing keeps it solvable.
+                warnings.filterwarnings("ignore", message="`degree` should not be below", category=UserWarning)
+                return RBFInterpolator(U, residual, kernel=kernel, degree=degree, smoothing=1e-10)
         except np.linalg.LinAlgError:
             continue
     return lambda Uc: np.zeros(len(np.atleast_2d(Uc)))

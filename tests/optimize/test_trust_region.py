@@ -1,8 +1,10 @@
 """Trust-region steps on a corrected model: known minima, the budget, and the best simulation kept."""
 
+import warnings
+
 import numpy as np
 
-from mechopt.optimize.sparse.trust_region import trust_region_steps
+from mechopt.optimize.sparse.trust_region import residual_model, trust_region_steps
 
 BOX = np.array([[0.0, 10.0], [-5.0, 5.0], [100.0, 300.0]])
 X_TRUE = np.array([3.0, 1.0, 220.0])
@@ -74,3 +76,13 @@ def test_failed_simulations_shrink_the_region_and_are_not_kept():
 
     res = trust_region_steps(biased_model, simulate, everywhere, BOX, X, q, budget=20, seed=3)
     assert np.isfinite(res.value) and res.x[1] <= 2.0
+
+
+def test_designs_in_one_plane_get_the_constant_tail_quietly_and_are_interpolated():
+    # Five designs in the plane x3 = 0.5 of the unit cube: a linear tail in 3-D is singular there.
+    U = np.array([[0.0, 0.0, 0.5], [1.0, 0.0, 0.5], [0.0, 1.0, 0.5], [1.0, 1.0, 0.5], [0.5, 0.5, 0.5]])
+    residual = np.array([0.0, 1.0, 2.0, 3.0, 4.0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        model = residual_model(U, residual, kernel="cubic")
+    np.testing.assert_allclose(model(U), residual, atol=1e-6)
