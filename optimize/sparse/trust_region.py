@@ -324,9 +324,10 @@ def residual_model(U: np.ndarray, residual: np.ndarray,
     """Radial-basis interpolant of the residuals with a linear tail, a constant one when the designs span too few
     dimensions for a plane (few lines, all samples in one plane), nothing when even that fails.
 
-    A tiny smoothing keeps the system solvable when two designs nearly coincide.
+    A tiny smoothing keeps the system solvable when two designs nearly coincide.  Fewer designs than a plane has
+    coefficients (d + 1) get the constant tail at once.
     """
-    for degree in (1, 0):
+    for degree in (1, 0) if U.shape[0] > U.shape[1] else (0,):
         try:
             with warnings.catch_warnings():
                 # scipy warns that a cubic kernel wants at least a linear tail; the constant one is the fallback

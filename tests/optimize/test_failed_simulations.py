@@ -72,3 +72,19 @@ def test_a_simulator_failing_in_most_of_the_box_gets_the_model_as_soon_as_two_su
     assert r.nfev == 30
     assert r.nfailed <= 20  # measured 13
     assert r.fun < 0.9  # the minimum 0.81 at (0.9, 0, 0); measured 0.824
+
+
+def test_sparse_global_learns_where_the_simulator_fails():
+    # At 60 simulations the lines leave few successes; the steps on the corrected model, fitted to those only,
+    # went on into the failing region: 22, 53, 54, 54 and 53 of 60 failed in seeds 0-4, median gap 4.1 %.
+    import numpy as np
+
+    problem = SUITE["failing_hartmann3"]()
+    failed, gaps = [], []
+    for seed in range(5):
+        result = mechopt.minimize(problem, budget=60, method="sparse-global", seed=seed)
+        assert result.nfev == 60
+        failed.append(result.nfailed)
+        gaps.append(100 * (result.fun - problem.f_min) / problem.f_range)
+    assert max(failed) <= 25  # measured 10, 10, 17, 13, 10
+    assert np.median(gaps) < 0.5  # measured 0.013 %
