@@ -129,12 +129,14 @@ def cell(p: TestFunction, method: str, budget: int, seeds: range) -> tuple[str, 
     return text, time.perf_counter() - t0
 
 
-def suite_table(budgets: list[int], n_seeds: int, ego: bool) -> None:
+def suite_table(budgets: list[int], n_seeds: int, ego: bool, names: list[str] | None = None) -> None:
     methods = ["auto", "sparse", "sparse-model", "DE"] + (["EGO"] if ego else [])
     print(f"median gap (% of range) | seeds in the global basin | median evaluations; {n_seeds} seeds "
           f"(EGO: 3 seeds, smallest budget)")
     print(f"{'function':16s} {'d':>1s} {'budget':>6s} " + " ".join(f"{m:>26s}" for m in methods))
     for name, cls in SUITE.items():
+        if names and name not in names:
+            continue
         p = cls()
         for budget in budgets:
             if p.dim == 2 and budget > MAX_BUDGET_2D:
@@ -185,12 +187,13 @@ def main() -> None:
     ap.add_argument("--seeds", type=int, default=10)
     ap.add_argument("--budgets", type=int, nargs="+", default=[100, 150, 300])
     ap.add_argument("--ego", action="store_true", help="add SMT EGO (slow: minutes per run)")
+    ap.add_argument("--functions", nargs="+", choices=sorted(SUITE), help="only these suite functions")
     ap.add_argument("--ventilator", action="store_true", help="add the ventilator (analytic engine)")
     ap.add_argument("--ventilator-only", action="store_true")
     ap.add_argument("--ventilator-budgets", type=int, nargs="+", default=[50, 100, 300])
     args = ap.parse_args()
     if not args.ventilator_only:
-        suite_table(args.budgets, args.seeds, args.ego)
+        suite_table(args.budgets, args.seeds, args.ego, args.functions)
     if args.ventilator or args.ventilator_only:
         ventilator(args.ventilator_budgets, args.seeds)
 
