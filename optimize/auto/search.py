@@ -182,24 +182,36 @@ class _Run:
     def fit(self, idx: np.ndarray | None = None) -> tuple[GaussianProcess, float]:
         """GP of the standardised values (of ``idx``, default all) and the incumbent's target.
 
-        A failed design enters at the worst value that succeeded: the model then expects nothing better next to a
-        failure and the expected improvement there drops (the success model only scales it).
+        The hyperparameters are fitted to the designs that succeeded; a failed design then enters at the model's
+        prediction plus its variance there (Forrester, Sóbester & Keane 2006, penalised imputation).  Inside a
+        failing region no success is near, the variance is large, and the model expects nothing good next to it;
+        a sporadic failure among successes (a solver that did not converge at one design) is imputed at about what
+        its neighbours say, and leaves the landscape as it is.  The success model scales the expected improvement
+        besides.  Before, a failure entered at the worst value that succeeded: a spike beside the optimum that the
+        fit followed with short length-scales (Hartmann-3 at 30 simulations with 15 % of the designs failing at
+        random: 2.29 % of the range, median of 10 seeds; 0.0040 % now).
         """
         idx = np.arange(self.values.size) if idx is None else idx
         values = self.values[idx]
-        # The worst finite value: an objective of +inf (a design the user's objective rejects) fails as NaN does,
-        # and must not become the target that standardising turns into NaN.
-        finite = values[np.isfinite(values)]
-        finite = finite if finite.size else self.values[self.ok]
-        worst = float(finite.max()) if finite.size else 0.0
-        y = standardise(np.where(np.isfinite(values), values, worst), compress_tail=self.prior)
-        full = self.theta is None or idx.size >= 1.25 * self.n_full_fit
+        # An objective of +inf (a design the user's objective rejects) fails as NaN does.
+        ok = np.isfinite(values)
+        if ok.sum() < 2:
+            # Nothing to fit to: the failures at the worst value that succeeded anywhere (or 0).
+            finite = values[ok] if ok.any() else self.values[self.ok]
+            values, ok = np.where(ok, values, float(finite.max()) if finite.size else 0.0), np.ones_like(ok)
+        good = idx[ok]
+        y = standardise(values[ok], compress_tail=self.prior)
+        full = self.theta is None or good.size >= 1.25 * self.n_full_fit
         if full:
-            self.n_full_fit = idx.size
+            self.n_full_fit = good.size
         # The global plan (no length-scale prior) starts from a few designs whose evidence may see white noise.
-        gp = fit_gp(self.U[idx], y, self.rng, warm=self.theta, starts=3 if full else 1, maxiter=100 if full else 30,
+        gp = fit_gp(self.U[good], y, self.rng, warm=self.theta, starts=3 if full else 1, maxiter=100 if full else 30,
                     prior=self.prior, spacing_floor=not self.prior)
         self.theta = gp.theta
+        if not ok.all():
+            failed = self.U[idx[~ok]]
+            mean, sd = gp.predict(failed)
+            gp = GaussianProcess(np.vstack([gp.X, failed]), np.concatenate([gp.y, mean + sd * sd]), gp.theta)
         return gp, float(y.min())
 
     def success_model(self, gp: GaussianProcess) -> Callable[[np.ndarray], np.ndarray] | None:
@@ -343,7 +355,8 @@ def _trust_region_plan(run: _Run, plan: Plan) -> None:
         members += list(range(n0, run.values.size))
         new = run.values[n0:]
         new = new[np.isfinite(new)]
-        tr.update(bool(new.size) and new.min() < before - 1e-3 * abs(before))
+        # A restart whose centre failed has no value to beat (inf): any success is one.
+        tr.update(bool(new.size) and (not np.isfinite(before) or new.min() < before - 1e-3 * abs(before)))
         if tr.collapsed and run.remaining > 0:
             tr.restart()
             n0 = run.values.size

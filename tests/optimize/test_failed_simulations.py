@@ -88,3 +88,35 @@ def test_sparse_global_learns_where_the_simulator_fails():
         gaps.append(100 * (result.fun - problem.f_min) / problem.f_range)
     assert max(failed) <= 25  # measured 10, 10, 17, 13, 10
     assert np.median(gaps) < 0.5  # measured 0.013 %
+
+
+def _sporadic(X):
+    """True at about 15 % of designs, scattered at random but fixed by the design (a solver that does not converge
+    at some parameter values, with no region to learn)."""
+    import numpy as np
+
+    h = np.sin(X @ np.array([12.9898, 78.233, 37.719])[: X.shape[1]]) * 43758.5453
+    return h - np.floor(h) < 0.15
+
+
+def test_failures_scattered_among_successes_leave_the_landscape_as_it_is():
+    # A failure used to enter the model at the worst value that succeeded: beside the optimum that is a spike the fit
+    # followed with short length-scales (median gap 1.84 % over these 10 seeds, 2 runs within 0.01 %).  Now it enters
+    # at the model's prediction plus its variance there: median 0.0087 %, 6 runs within 0.01 %.
+    import numpy as np
+
+    from mechopt.optimize.auto.search import auto_search
+    from mechopt.studies.test_functions import Hartmann3
+
+    f = Hartmann3()
+
+    def evaluate(X):
+        return np.where(_sporadic(X), np.nan, f.function(X))
+
+    gaps, failed = [], 0
+    for seed in range(10):
+        r = auto_search(evaluate, np.array([[0.0, 1.0]] * 3), 30, seed=seed)
+        gaps.append(100 * (r.fun - f.f_min) / f.f_range)
+        failed += r.nfailed
+    assert failed >= 30  # the runs did meet failures (measured 54 of 300)
+    assert np.median(gaps) < 0.1
