@@ -198,7 +198,7 @@ class _Run:
         # An objective of +inf (a design the user's objective rejects) fails as NaN does.
         ok = np.isfinite(values)
         if ok.sum() < 2:
-            # Nothing to fit to: the failures at the worst value that succeeded anywhere (or 0).
+            # Too few successes to fit to: the failures at the worst value that succeeded (here, else anywhere; or 0).
             finite = values[ok] if ok.any() else self.values[self.ok]
             values, ok = np.where(ok, values, float(finite.max()) if finite.size else 0.0), np.ones_like(ok)
         good = idx[ok]
