@@ -272,7 +272,7 @@ class ProcessExecutor(SampleExecutor):
         InputError
             If ``fn`` cannot be pickled (lambda, local function...).
         StudyError
-            If a worker process died (crash in native code, out of memory, killed).
+            If a worker process died (crash in native code, out of memory, killed, or a script without a main guard).
         """
         if self._pool is None:
             raise InputError("the executor is closed")
@@ -286,21 +286,22 @@ class ProcessExecutor(SampleExecutor):
             ) from exc
         pool = self._pool
         it = iter(items)
-        pending: set[Future] = {pool.submit(fn, item) for item in islice(it, self.max_in_flight)}
+        pending: set[Future] = set()
         try:
+            pending.update(pool.submit(fn, item) for item in islice(it, self.max_in_flight))
             while pending:
                 done, pending = wait(pending, return_when=FIRST_COMPLETED)
                 for fut in done:
-                    try:
-                        result = fut.result()
-                    except BrokenProcessPool as exc:
-                        raise StudyError(
-                            "a worker process died (crash in native code, out of memory or killed); "
-                            "results so far are saved, run again to resume"
-                        ) from exc
-                    yield result
+                    yield fut.result()
                     # Refill only now that the consumer has taken (and saved) the result.
                     pending.update(pool.submit(fn, item) for item in islice(it, 1))
+        except BrokenProcessPool as exc:
+            # A script that starts workers re-runs its top level in each of them unless guarded: they die at start.
+            raise StudyError(
+                "a worker process died (crash in native code, out of memory, killed, or a script that runs "
+                "workers without `if __name__ == \"__main__\":` around its top level); results so far are saved, "
+                "run again to resume"
+            ) from exc
         finally:
             for fut in pending:
                 fut.cancel()

@@ -433,3 +433,19 @@ def test_a_terminal_ctrl_c_is_left_to_the_main_process(tmp_path):
         with contextlib.suppress(ProcessLookupError):
             os.killpg(proc.pid, signal.SIGKILL)
     assert err.strip() == "interrupted", err
+
+
+def test_a_script_that_starts_workers_without_a_main_guard_is_told_why_they_died(tmp_path):
+    # Each worker process re-runs an unguarded script's top level, and Python stops it at start: the pool breaks.
+    script = tmp_path / "unguarded.py"
+    script.write_text(
+        "import mechopt\n"
+        "from mechopt.studies.test_functions import Hartmann3\n"
+        "mechopt.minimize(Hartmann3(), budget=10, seed=0, workers=2)\n"
+    )
+    proc = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120,
+                          cwd=tmp_path)
+    assert proc.returncode != 0
+    last = proc.stderr.strip().splitlines()[-1]
+    assert last.startswith("mechopt.errors.StudyError: a worker process died")
+    assert 'if __name__ == "__main__":' in last
