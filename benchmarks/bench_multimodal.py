@@ -121,6 +121,8 @@ def cell(p: TestFunction, method: str, budget: int, seeds: range) -> tuple[str, 
     t0 = time.perf_counter()
     for s in seeds:
         fun, x, nfev = METHODS[method](p, budget, s)
+        # The closed form at the design returned: a noisy function's simulated value is partly its noise.
+        fun = float(p(x[None, :])[0]) if math.isfinite(fun) and np.all(np.isfinite(x)) else fun
         gaps.append(100.0 * p.gap(fun) if math.isfinite(fun) else math.inf)
         hits += bool(np.all(np.isfinite(x))) and p.in_global_basin(x)
         nfevs.append(nfev)

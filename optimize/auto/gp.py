@@ -45,7 +45,7 @@ from scipy.optimize import minimize
 
 from mechopt.optimize.auto.additive_kernel import additive_gradient, additive_gram, additive_matern
 
-__all__ = ["GaussianProcess", "fit_gp"]
+__all__ = ["GaussianProcess", "fit_gp", "noise_log_bayes_factor"]
 
 _SQRT5 = math.sqrt(5.0)
 #: Bounds of log length-scale (unit cube), log signal variance and log noise variance (standardised targets).
@@ -320,3 +320,33 @@ def _fit(X: np.ndarray, y: np.ndarray, rng: np.random.Generator, warm: np.ndarra
         # 55 s of the method's own time instead of 65 s).
         best = best[: d + 2]
     return GaussianProcess(X, y, best)
+
+
+def noise_log_bayes_factor(gp: GaussianProcess, n: int, prior: bool) -> float:
+    """ln of the Bayes factor of ``gp``'s fitted white noise against none, on its first ``n`` designs.
+
+    The model without noise (the variance at its floor, every other hyperparameter fitted again, from ``gp``'s) is
+    the interpolating one a deterministic simulator deserves; its log posterior is compared with ``gp``'s.  A smooth
+    function that the kernel fits imperfectly buys a little noise for a few nats; values that scatter from design to
+    design cannot be interpolated without length-scales shorter than the designs' spacing, and lose many.
+
+    Parameters
+    ----------
+    gp : GaussianProcess
+        A fitted model (:func:`fit_gp`).
+    n : int
+        Its leading designs the factor is measured on (the designs that were simulated, not imputed).
+    prior : bool
+        Whether ``gp`` was fitted with the length-scale prior.
+    """
+    X, y = gp.X[:n], gp.y[:n]
+    d = X.shape[1]
+    prior_mu = math.sqrt(2.0) + 0.5 * math.log(d)
+    theta = gp.theta if gp.theta.size > d + 2 else np.append(gp.theta, _LOG_ADDITIVE[0])
+    fitted = _neg_log_posterior(theta, X, y, prior_mu, float(prior))[0]
+    bounds = [_LOG_ELL] * d + [_LOG_SIGNAL, (_LOG_NOISE[0], _LOG_NOISE[0]), _LOG_ADDITIVE]
+    start = theta.copy()
+    start[d + 1] = _LOG_NOISE[0]
+    res = minimize(_neg_log_posterior, start, args=(X, y, prior_mu, float(prior)), jac=True, method="L-BFGS-B",
+                   bounds=bounds, options={"maxiter": 100, "ftol": _FTOL})
+    return float(min(res.fun, _neg_log_posterior(start, X, y, prior_mu, float(prior))[0]) - fitted)

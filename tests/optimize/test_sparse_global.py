@@ -34,8 +34,9 @@ def test_known_minimum_and_range(name):
     lo, hi = dense_grid_range(p, n) if n else sampled_range(p, 2**12)
     assert lo >= p.f_min - 1e-9
     assert 0.97 * p.f_range <= hi - p.f_min <= p.f_range * (1 + 1e-4)
-    # evaluate() of the protocol and the batch call agree.
-    assert p.evaluate(p.x_min[0])["f"] == pytest.approx(float(p(p.x_min[:1])[0]))
+    # evaluate() of the protocol and the batch call agree (to the noise of a noisy one: 5 of its sd).
+    noise = getattr(p, "noise", 0.0) * p.f_range
+    assert p.evaluate(p.x_min[0])["f"] == pytest.approx(float(p(p.x_min[:1])[0]), abs=5 * noise)
 
 
 def test_basin_membership():
