@@ -322,13 +322,16 @@ def _fit(X: np.ndarray, y: np.ndarray, rng: np.random.Generator, warm: np.ndarra
     return GaussianProcess(X, y, best)
 
 
-def noise_log_bayes_factor(gp: GaussianProcess, n: int, prior: bool) -> float:
-    """ln of the Bayes factor of ``gp``'s fitted white noise against none, on its first ``n`` designs.
+def noise_log_bayes_factor(gp: GaussianProcess, n: int, prior: bool, null_noise: float) -> float:
+    """ln of the Bayes factor of ``gp``'s fitted white noise against a negligible one, on its first ``n`` designs.
 
-    The model without noise (the variance at its floor, every other hyperparameter fitted again, from ``gp``'s) is
-    the interpolating one a deterministic simulator deserves; its log posterior is compared with ``gp``'s.  A smooth
-    function that the kernel fits imperfectly buys a little noise for a few nats; values that scatter from design to
-    design cannot be interpolated without length-scales shorter than the designs' spacing, and lose many.
+    The model with the noise variance fixed at ``null_noise`` (every other hyperparameter fitted again, from
+    ``gp``'s) is the near-interpolating one a deterministic simulator deserves; its log posterior is compared with
+    ``gp``'s.  A smooth function that the kernel fits imperfectly buys a little noise for a few nats; values that
+    scatter from design to design cannot be interpolated without length-scales shorter than the designs' spacing,
+    and lose many.  The null is a small noise rather than the floor: designs a hair apart (a polish beside the
+    incumbent) leave the covariance singular to rounding at the floor, and a failed factorisation would count as
+    evidence for noise.
 
     Parameters
     ----------
@@ -338,15 +341,18 @@ def noise_log_bayes_factor(gp: GaussianProcess, n: int, prior: bool) -> float:
         Its leading designs the factor is measured on (the designs that were simulated, not imputed).
     prior : bool
         Whether ``gp`` was fitted with the length-scale prior.
+    null_noise : float
+        Noise variance of the model without noise (standardised values).
     """
     X, y = gp.X[:n], gp.y[:n]
     d = X.shape[1]
     prior_mu = math.sqrt(2.0) + 0.5 * math.log(d)
     theta = gp.theta if gp.theta.size > d + 2 else np.append(gp.theta, _LOG_ADDITIVE[0])
     fitted = _neg_log_posterior(theta, X, y, prior_mu, float(prior))[0]
-    bounds = [_LOG_ELL] * d + [_LOG_SIGNAL, (_LOG_NOISE[0], _LOG_NOISE[0]), _LOG_ADDITIVE]
+    log_null = math.log(null_noise)
+    bounds = [_LOG_ELL] * d + [_LOG_SIGNAL, (log_null, log_null), _LOG_ADDITIVE]
     start = theta.copy()
-    start[d + 1] = _LOG_NOISE[0]
+    start[d + 1] = log_null
     res = minimize(_neg_log_posterior, start, args=(X, y, prior_mu, float(prior)), jac=True, method="L-BFGS-B",
                    bounds=bounds, options={"maxiter": 100, "ftol": _FTOL})
     return float(min(res.fun, _neg_log_posterior(start, X, y, prior_mu, float(prior))[0]) - fitted)
