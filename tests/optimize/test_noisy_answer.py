@@ -81,3 +81,15 @@ def test_the_evidence_for_noise_is_strong_on_scattered_values_and_absent_on_a_sm
     for y, strong in ((smooth, False), (smooth + 0.05 * rng.standard_normal(30), True)):
         gp = fit_gp(U, standardise(y), rng, starts=3, maxiter=100, prior=False)
         assert (noise_log_bayes_factor(gp, 30, prior=False, null_noise=1e-6) > 3.0) is strong
+
+
+def test_minimize_on_the_noisy_suite_function_says_so_and_reports_the_answers_own_simulation():
+    import mechopt
+
+    p = NoisyHartmann6()
+    r = mechopt.minimize(p, budget=60, seed=0)
+    assert "looks noisy" in r.message
+    assert r.fun == p.evaluate(np.asarray(r.x))["f"]  # the simulated value, noise included, not the model's
+    # The answer is not the design of lowest simulated value, which the message quotes last.
+    lowest = float(r.message.rsplit("(", 1)[1].rstrip(")"))
+    assert r.fun > lowest
