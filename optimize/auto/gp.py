@@ -293,11 +293,16 @@ def _sees_no_neighbour(gp: GaussianProcess) -> bool:
     return bool(np.median(C.max(axis=1)) < _NO_NEIGHBOUR)
 
 
+def _prior_mean(d: int) -> float:
+    """Mean of the log length-scale prior in ``d`` variables (Hvarfner, Hellsten & Nardi 2024)."""
+    return math.sqrt(2.0) + 0.5 * math.log(d)
+
+
 def _fit(X: np.ndarray, y: np.ndarray, rng: np.random.Generator, warm: np.ndarray | None, starts: int,
          maxiter: int, prior: bool, log_ell_min: float) -> GaussianProcess:
     """:func:`fit_gp` with ``log_ell_min`` as the lower bound of every log length-scale."""
     d = X.shape[1]
-    prior_mu = math.sqrt(2.0) + 0.5 * math.log(d)
+    prior_mu = _prior_mean(d)
     log_ell = (log_ell_min, _LOG_ELL[1])
     bounds = [log_ell] * d + [_LOG_SIGNAL, _LOG_NOISE, _LOG_ADDITIVE]
     lo, hi = np.array(bounds).T
@@ -346,7 +351,7 @@ def noise_log_bayes_factor(gp: GaussianProcess, n: int, prior: bool, null_noise:
     """
     X, y = gp.X[:n], gp.y[:n]
     d = X.shape[1]
-    prior_mu = math.sqrt(2.0) + 0.5 * math.log(d)
+    prior_mu = _prior_mean(d)
     theta = gp.theta if gp.theta.size > d + 2 else np.append(gp.theta, _LOG_ADDITIVE[0])
     fitted = _neg_log_posterior(theta, X, y, prior_mu, float(prior))[0]
     log_null = math.log(null_noise)

@@ -319,9 +319,9 @@ def _apart(U: np.ndarray, chosen: np.ndarray) -> np.ndarray:
     return np.min(np.max(np.abs(U[:, None, :] - chosen[None, :, :]), axis=2), axis=1) > 1e-6
 
 
-def _local_indices(run: _Run, centre: np.ndarray) -> np.ndarray:
+def _local_indices(run: _Run, centre: np.ndarray, most: int = LOCAL_POINTS) -> np.ndarray:
     dist = np.linalg.norm(run.U - centre, axis=1)
-    return np.argsort(dist)[:LOCAL_POINTS]
+    return np.argsort(dist)[:most]
 
 
 def _restart_centre(run: _Run) -> np.ndarray:
@@ -378,7 +378,7 @@ def _answer(run: _Run, plan: Plan) -> tuple[int, str]:
     if plan.name == "least-squares" or run.ok.sum() < 3:
         return best, ""
     with _limited_threads():
-        idx = np.argsort(np.linalg.norm(run.U - run.U[best], axis=1))[:ANSWER_POINTS]
+        idx = _local_indices(run, run.U[best], ANSWER_POINTS)
         # A fit of its own, from several starts: the search's last fits were warm-started on fewer designs.
         run.theta = None
         gp, _ = run.fit(idx)
