@@ -16,7 +16,7 @@ __all__ = ["add_parsers", "method_lines", "run_init", "run_methods", "run_studie
 #: One line for each line-model method (the baselines carry theirs in ``BASELINE_DOCS``).
 _SPARSE_DOCS = {
     "auto": "the default (and of every study that names none): Gaussian-process steps (Matern-5/2, expected "
-    "improvement) on a plan chosen by d and budget (one global model to 4 variables, restarted trust regions above), "
+    "improvement): one global model up to 300 designs, restarted trust regions beyond, "
     "or Gauss-Newton runs from multi-level single linkage starts when the problem declares residuals; failed "
     "simulations learned and avoided (budget >= 2d + 2).",
     "sparse": "paper 002's line model: lines sampled, fitted by sums of exponentials, blended by Chebyshev "

@@ -78,7 +78,7 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
         Most simulations the method may ask for (validation simulations of the sparse method come on top).
     method : str or callable
         ``"auto"`` (default: a plan chosen by dimension, budget and the problem's declaration, 2 to 12 variables,
-        budgets from 2d + 2: Gaussian-process steps, in a trust region above 4 variables, or Gauss-Newton runs on the
+        budgets from 2d + 2: Gaussian-process steps, in trust regions beyond 300 designs, or Gauss-Newton runs on the
         residuals of a least-squares problem; failed simulations learned and avoided; :mod:`mechopt.optimize.auto`),
         ``"sparse"`` (the line-sampled sparse model of paper 002, then a local search on the simulator; 2 to 4
         variables),

@@ -144,8 +144,8 @@ def propose_batch(gp: GaussianProcess, best: float, lo: np.ndarray, hi: np.ndarr
         ``margins(U) -> (m, c)``: declared constraints' margins (>= 0 feasible) at designs U of the unit cube; the
         polish of each choice then respects them and may end on one.
     sparse : bool
-        Offer perturbations of the centre in any number of its coordinates (:func:`_candidates`); the trust-region
-        plan's choice, in 5 variables and more, where Sobol points of the box are too sparse to hold such moves.
+        Offer perturbations of the centre in any number of its coordinates (:func:`_candidates`); the trust
+        regions' choice, where Sobol points of the box are too sparse to hold such moves in many variables.
 
     Returns
     -------

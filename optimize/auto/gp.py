@@ -30,7 +30,9 @@ Hartmann-3 0.0047 -> 0.0035 %, Styblinski-Tang-3 3.19 -> 1.37 %, cosine_bowl4 15
 The optional prior on the length-scales is the dimension-scaled log-normal of Hvarfner, Hellsten & Nardi (2024):
 log ℓ ~ N(√2 + ½ log d, √3), derived for many variables, where a few dozen designs leave most length-scales
 undetermined and plain ML-II collapses them onto tiny values (every unexplored point then looks equally
-promising).  In 2 to 4 variables the designs fix the length-scales and the prior only biases them long.
+promising).  The trust regions' local fits use it; the global model does not, in any number of variables: there
+the designs fix the length-scales and the prior only biases them long (measured up to 12 variables,
+:mod:`mechopt.optimize.auto.plan`).
 Targets are expected standardised (:mod:`mechopt.optimize.auto.transform`).
 """
 

@@ -1,5 +1,5 @@
-"""The default method of :func:`mechopt.minimize`: Gaussian-process steps on a plan chosen by dimension and budget
-(:mod:`mechopt.optimize.auto.plan`), failed simulations learned as a hidden constraint.
+"""The default method of :func:`mechopt.minimize`: Gaussian-process steps on a plan chosen by the budget and the
+problem's declaration (:mod:`mechopt.optimize.auto.plan`), failed simulations learned as a hidden constraint.
 
 Every phase proposes ``batch`` designs at once (the kriging believer), so that parallel workers can simulate a
 step together; the budget is spent exactly, on distinct designs only.  The answer is the design of lowest simulated
@@ -95,8 +95,9 @@ class _Run:
         self.values = np.zeros(0)
         self.theta: np.ndarray | None = None
         self._tree: cKDTree | None = None
-        #: Local models (trust-region plan): the length-scale prior of :mod:`~mechopt.optimize.auto.gp` and the
-        #: compressed upper tail of :mod:`~mechopt.optimize.auto.transform`; a global model has neither.
+        #: Local models (the trust regions beyond the global model's size): the length-scale prior of
+        #: :mod:`~mechopt.optimize.auto.gp` and the compressed upper tail of :mod:`~mechopt.optimize.auto.transform`;
+        #: a global model has neither.
         self.prior = False
         self.n_full_fit = 0
 
@@ -439,7 +440,6 @@ def auto_search(evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, seed:
     d = bounds.shape[0]
     plan = choose_plan(d, int(budget), int(batch), least_squares=residuals is not None)
     run = _Run(evaluate, bounds, int(budget), feasible, np.random.default_rng(seed), margins, residuals)
-    run.prior = plan.name == "trust-region"
     with _limited_threads():
         n_init, n_x0 = plan.n_init, 0
         if initial is not None and len(initial):
@@ -464,7 +464,7 @@ def auto_search(evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, seed:
             if plan.name == "least-squares":
                 least_squares_plan(run, plan.batch, fd_step, run.unit_margins)
             else:
-                (_global_plan if plan.name == "global" else _trust_region_plan)(run, plan)
+                _global_plan(run, plan)
     nfailed = int((~run.ok).sum())
     noisy = ""
     if run.ok.any():

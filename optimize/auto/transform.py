@@ -4,8 +4,8 @@ A minimiser only needs the model to rank and resolve the low values; values far 
 walls, a simulator's near-failures) would otherwise set the GP's signal variance and length-scales and flatten
 everything that matters.  Both transforms below are monotone, so the ordering and every minimum are kept.
 
-* A local model (the ``trust-region`` plan): above the median the values are mapped through log1p of their robust
-  z-score, then the whole is standardised.
+* A local model (the trust regions that continue a budget beyond the global model's size): above the median the
+  values are mapped through log1p of their robust z-score, then the whole is standardised.
 * A global model (the ``global`` plan) has to see the walls between basins, and that fixed compression flattened
   them (measured on Styblinski–Tang 3-D at 30 simulations: median gap 4.5 % compressed, 0.6 % plain, same six
   seeds).  Its values go through the Yeo-Johnson power transform whose exponent λ makes them most nearly Gaussian,

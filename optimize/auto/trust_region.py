@@ -1,9 +1,10 @@
 """A trust region in the unit cube that grows after successes and shrinks after failures (TuRBO: Eriksson et al.
 2019), restarted elsewhere once it has shrunk below a minimum.
 
-Above four variables a global GP over the whole box is mostly uncertainty: its expected improvement is largest at
-the box's faces and corners and the search never settles.  A box around the incumbent, stretched along the
-variables the GP finds the objective slowly varying in, keeps the model local and the steps where it is accurate.
+Beyond the global GP's size (:data:`~mechopt.optimize.auto.plan.GLOBAL_MAX_POINTS`) the search goes on locally: a
+box around the incumbent, stretched along the variables the GP finds the objective slowly varying in, keeps the
+model local (fitted to the designs nearest the centre) and the steps where it is accurate; a sharp minimum is
+refined there better than by one stationary model of the whole box.
 """
 
 from __future__ import annotations
