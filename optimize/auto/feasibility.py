@@ -39,7 +39,8 @@ class SuccessModel:
         labels = np.where(succeeded, 1.0, -1.0)
         self.prior = float(labels.mean())
         theta = np.concatenate([log_ell, [0.0, np.log(_LABEL_NOISE)]])
-        self.gp = GaussianProcess(X, labels - self.prior, theta)
+        # A constant mean: the labels are a step, and a quadratic trend would carry a failing region across the box.
+        self.gp = GaussianProcess(X, labels - self.prior, theta, quadratic=False)
 
     def log_probability(self, U: np.ndarray) -> np.ndarray:
         """log P(success) at designs U (m, d)."""

@@ -15,17 +15,19 @@ cosine_bowl4 9.8 -> 7.7 %, Hartmann-3 0.0020 -> 0.00067 %; cosine_bowl3 0.044 ->
 seeds instead of 15: a bowl, additive, under a product of cosines, which is not).  A component the evidence gives
 under 1e-3 of the product's variance is left out of the fitted model, which then costs what the product alone does.
 
-The prior mean is a constant estimated by generalised least squares at the fitted hyperparameters (ordinary
+The hyperparameters are fitted under a constant prior mean, estimated by generalised least squares (ordinary
 kriging's mean, the model of DACE and of EGO: Jones, Schonlau & Welch 1998; BoTorch's constant mean fitted by
-maximum likelihood is the same estimate).  The plain average of the targets is a biased estimate of the function's
-level: a minimiser piles its designs into the low basins, so the average sinks, and with it what the model expects
-wherever it has not looked; every unexplored corner then seems promising.  Generalised least squares weighs a
-cluster of correlated designs about as one.  The level's own uncertainty is left out of the variance, as BoTorch
-does: on a smooth function with long length-scales the level is poorly determined, and that term made the far
-corners of a trust region look promising (Rosenbrock-6 at 300 simulations left its valley).  Measured with
-``benchmarks/bench_default.py`` (10 seeds; BENCHMARKS.md), median gap at 30 simulations: cosine_bowl3 0.080 -> 0.038 %,
-Hartmann-3 0.0047 -> 0.0035 %, Styblinski-Tang-3 3.19 -> 1.37 %, cosine_bowl4 15.0 -> 10.7 %, Hartmann-4 1.50 ->
-0.56 %; median best value at 500: Ackley-8 0.495 -> 0.0051, Levy-8 0.909 -> 5.6e-6; Rosenbrock-6 at 300 2.35 -> 2.50.
+maximum likelihood is the same estimate); where the designs pay for one, the model predicts with a quadratic trend
+in its place (:mod:`~mechopt.optimize.auto.trend`).  The plain average of the targets is a biased estimate of the
+function's level: a minimiser piles its designs into the low basins, so the average sinks, and with it what the
+model expects wherever it has not looked; every unexplored corner then seems promising.  Generalised least squares
+weighs a cluster of correlated designs about as one.  The level's own uncertainty is left out of the variance, as
+BoTorch does: on a smooth function with long length-scales the level is poorly determined, and that term made the
+far corners of a trust region look promising (Rosenbrock-6 at 300 simulations left its valley).  Measured with
+``benchmarks/bench_default.py`` (10 seeds; BENCHMARKS.md), median gap at 30 simulations: cosine_bowl3 0.080 ->
+0.038 %, Hartmann-3 0.0047 -> 0.0035 %, Styblinski-Tang-3 3.19 -> 1.37 %, cosine_bowl4 15.0 -> 10.7 %, Hartmann-4
+1.50 -> 0.56 %; median best value at 500: Ackley-8 0.495 -> 0.0051, Levy-8 0.909 -> 5.6e-6; Rosenbrock-6 at 300 2.35 ->
+2.50.
 
 The optional prior on the length-scales is the dimension-scaled log-normal of Hvarfner, Hellsten & Nardi (2024):
 log ℓ ~ N(√2 + ½ log d, √3), derived for many variables, where a few dozen designs leave most length-scales
@@ -46,6 +48,7 @@ from scipy.linalg.lapack import dpotri
 from scipy.optimize import minimize
 
 from mechopt.optimize.auto.additive_kernel import additive_gradient, additive_gram, additive_matern
+from mechopt.optimize.auto.trend import Trend
 
 __all__ = ["GaussianProcess", "fit_gp", "noise_log_bayes_factor"]
 
@@ -132,9 +135,11 @@ class GaussianProcess:
     theta : (d + 2,) or (d + 3,) ndarray
         log length-scales, log signal variance (the product kernel's), log noise variance and, with d + 3 entries,
         the additive component's log variance.
+    quadratic : bool, optional
+        The prior mean's form (:class:`~mechopt.optimize.auto.trend.Trend`); default: by the number of designs.
     """
 
-    def __init__(self, X: np.ndarray, y: np.ndarray, theta: np.ndarray) -> None:
+    def __init__(self, X: np.ndarray, y: np.ndarray, theta: np.ndarray, quadratic: bool | None = None) -> None:
         self.X, self.y, self.theta = np.asarray(X, float), np.asarray(y, float), np.asarray(theta, float)
         d = self.X.shape[1]
         self.signal, self.noise = math.exp(self.theta[d]), math.exp(self.theta[d + 1])
@@ -146,16 +151,16 @@ class GaussianProcess:
         K = self.K.copy()
         K[np.diag_indices_from(K)] += self.noise
         self.L = _cholesky(K, self.signal)
-        k1 = cho_solve((self.L, True), np.ones(self.y.size), check_finite=False)
-        #: The constant prior mean (generalised least squares).
-        self.mean_level = float(k1 @ self.y / k1.sum())
-        self.alpha = cho_solve((self.L, True), self.y - self.mean_level, check_finite=False)
+        #: The prior mean (generalised least squares).
+        self.trend = Trend(self.X, self.y, self.L, quadratic)
+        self.alpha = cho_solve((self.L, True), self.y - self.trend(self.X), check_finite=False)
 
     def predict(self, U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Posterior mean and standard deviation (of the latent function, no noise) at designs U (m, d), the mean
-        level taken as known."""
-        Ks = _covariance(np.atleast_2d(U), self.X, self.theta)
-        mean = self.mean_level + Ks @ self.alpha
+        """Posterior mean and standard deviation (of the latent function, no noise) at designs U (m, d), the prior
+        mean taken as known."""
+        U = np.atleast_2d(U)
+        Ks = _covariance(U, self.X, self.theta)
+        mean = self.trend(U) + Ks @ self.alpha
         V = solve_triangular(self.L, Ks.T, lower=True, check_finite=False)
         var = np.maximum(self.signal - np.sum(V * V, axis=0), 1e-12 * self.signal)
         return mean, np.sqrt(var)
@@ -174,13 +179,14 @@ class GaussianProcess:
         except np.linalg.LinAlgError:
             w, Q = np.linalg.eigh(C)
             F = Q * np.sqrt(np.maximum(w, 0.0))
-        return self.mean_level + Ks @ self.alpha + (F @ rng.standard_normal((U.shape[0], n))).T
+        return self.trend(U) + Ks @ self.alpha + (F @ rng.standard_normal((U.shape[0], n))).T
 
     def believe(self, U: np.ndarray) -> GaussianProcess:
         """The same GP with designs U (m, d) added at their posterior mean (the kriging believer of a batch)."""
         U = np.atleast_2d(U)
         mean, _ = self.predict(U)
-        return GaussianProcess(np.vstack([self.X, U]), np.concatenate([self.y, mean]), self.theta)
+        return GaussianProcess(np.vstack([self.X, U]), np.concatenate([self.y, mean]), self.theta,
+                               self.trend.quadratic)
 
 
 def _inverse(L: np.ndarray) -> np.ndarray:

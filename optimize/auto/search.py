@@ -219,7 +219,8 @@ class _Run:
         if not ok.all():
             failed = self.U[idx[~ok]]
             mean, sd = gp.predict(failed)
-            gp = GaussianProcess(np.vstack([gp.X, failed]), np.concatenate([gp.y, mean + sd * sd]), gp.theta)
+            gp = GaussianProcess(np.vstack([gp.X, failed]), np.concatenate([gp.y, mean + sd * sd]), gp.theta,
+                                 gp.trend.quadratic)
         return gp, float(y.min())
 
     def success_model(self, gp: GaussianProcess) -> Callable[[np.ndarray], np.ndarray] | None:

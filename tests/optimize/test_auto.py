@@ -279,7 +279,7 @@ def test_mean_level_is_the_limit_of_a_random_constant_of_large_variance():
     X = np.vstack([0.1 * rng.random((9, 2)), rng.random((3, 2))])  # a cluster in a corner and three apart
     y = np.concatenate([-1.0 + 0.1 * rng.standard_normal(9), [1.0, 1.5, 0.8]])
     theta = np.array([np.log(0.15), np.log(0.2), 0.0, np.log(1e-6)])
-    gp = GaussianProcess(X, y, theta)
+    gp = GaussianProcess(X, y, theta, quadratic=False)  # 12 designs would carry the quadratic trend by default
     U = np.array([[0.05, 0.05], [0.5, 0.5], [0.95, 0.9], [3.0, 3.0]])
 
     def k(A, B):
@@ -296,6 +296,55 @@ def test_mean_level_is_the_limit_of_a_random_constant_of_large_variance():
     k1 = np.linalg.solve(K, np.ones(12))
     assert abs(mean[3] - k1 @ y / k1.sum()) < 1e-9
     assert mean[3] > y.mean() + 0.3
+
+
+def test_quadratic_trend_is_the_limit_of_random_coefficients_of_large_variance():
+    # Universal kriging (Santner et al. 2003): a zero-mean GP whose kernel has the term B·f(u)ᵀf(v), f = (1, u_k,
+    # u_k²), predicts, as B grows, the generalised least-squares trend plus the kriging of the residuals.
+    rng = np.random.default_rng(11)
+    X = rng.random((14, 3))
+    y = np.sin(4.0 * X[:, 0]) + (X[:, 1] - 0.3) ** 2 - X[:, 2]
+    theta = np.array([np.log(0.4)] * 3 + [0.0, np.log(1e-6)])
+    gp = GaussianProcess(X, y, theta, quadratic=True)
+    U = np.array([[0.5, 0.5, 0.5], [0.9, 0.1, 0.2], [1.5, -0.5, 2.0]])
+
+    def f(A):
+        return np.hstack([np.ones((A.shape[0], 1)), A, A * A])
+
+    def k(A, B):
+        D = (A[:, None, :] - B[None, :, :]) / 0.4
+        r = np.sqrt(np.sum(D * D, axis=2))
+        return (1 + np.sqrt(5) * r + 5 / 3 * r * r) * np.exp(-np.sqrt(5) * r)
+
+    big = 1e6
+    K = k(X, X) + 1e-6 * np.eye(14) + big * f(X) @ f(X).T
+    mean, _ = gp.predict(U)
+    np.testing.assert_allclose(mean, (k(U, X) + big * f(U) @ f(X).T) @ np.linalg.solve(K, y), atol=1e-4)
+
+
+def test_a_bowl_without_cross_terms_is_reproduced_far_from_the_designs():
+    # A function of the trend's class is its own prediction: nothing is left for the kriging of residuals.  With a
+    # constant mean the model reverts to the level away from the designs.
+    rng = np.random.default_rng(12)
+    X = 0.4 * rng.random((10, 2))  # designs in one corner
+    bowl = lambda U: 3.0 * (U[:, 0] - 0.7) ** 2 + 0.5 * (U[:, 1] - 0.2) ** 2 - 1.0  # noqa: E731
+    theta = np.array([np.log(0.3), np.log(0.3), 0.0, np.log(1e-6)])
+    U = np.array([[0.7, 0.2], [1.0, 1.0], [0.9, 0.6]])
+    np.testing.assert_allclose(GaussianProcess(X, bowl(X), theta, quadratic=True).predict(U)[0], bowl(U), atol=1e-6)
+    assert abs(GaussianProcess(X, bowl(X), theta, quadratic=False).predict(U[:1])[0][0] - bowl(U[:1])[0]) > 0.1
+
+
+def test_the_quadratic_trend_is_taken_only_where_the_designs_show_a_bowl():
+    # Information criterion (BIC): a bowl under ripples pays for its 2d terms, ripples alone do not; fewer than two
+    # designs a coefficient never carry it.
+    rng = np.random.default_rng(13)
+    X = rng.random((40, 2))
+    ripples = np.sin(6 * np.pi * X[:, 0]) * np.cos(6 * np.pi * X[:, 1])
+    bowl = 8.0 * np.sum((X - 0.4) ** 2, axis=1)
+    theta = np.array([np.log(0.1), np.log(0.1), 0.0, np.log(1e-6)])
+    assert GaussianProcess(X, bowl + ripples, theta).trend.quadratic
+    assert not GaussianProcess(X, ripples, theta).trend.quadratic
+    assert not GaussianProcess(X[:9], bowl[:9], theta).trend.quadratic  # 9 < 2 (2d + 1)
 
 
 def test_a_probe_off_a_bound_slides_along_the_constraint_active_there():
