@@ -136,7 +136,8 @@ class GaussianProcess:
         log length-scales, log signal variance (the product kernel's), log noise variance and, with d + 3 entries,
         the additive component's log variance.
     quadratic : bool, optional
-        The prior mean's form (:class:`~mechopt.optimize.auto.trend.Trend`); default: by the number of designs.
+        The prior mean's form (:class:`~mechopt.optimize.auto.trend.Trend`); default: quadratic where the designs
+        pay for it (their number and the information criterion).
     """
 
     def __init__(self, X: np.ndarray, y: np.ndarray, theta: np.ndarray, quadratic: bool | None = None) -> None:
