@@ -64,23 +64,20 @@ class Trend:
         self.centre = X.mean(axis=0) if n else np.zeros(d)
         spread = X.std(axis=0) if n else np.ones(d)
         self.scale = np.where(spread > 1e-12, spread, 1.0)
-        if quadratic is None:
-            quadratic = n >= DESIGNS_PER_TERM * (2 * d + 1) and self._quadratic_pays(X, y, L)
-        self.quadratic = bool(quadratic)
-        self.beta = self._gls(X, y, L)[0]
+        if quadratic is None and n >= DESIGNS_PER_TERM * (2 * d + 1):
+            # The Bayesian information criterion: the 2d terms must reduce the residuals' squared Mahalanobis norm
+            # by more than 2d·log n (twice the log-likelihood's price of 2d parameters).
+            beta_constant, misfit_constant = self._gls(X, y, L, False)
+            beta_quadratic, misfit_quadratic = self._gls(X, y, L, True)
+            self.quadratic = bool(misfit_constant - misfit_quadratic > 2 * d * np.log(n))
+            self.beta = beta_quadratic if self.quadratic else beta_constant
+        else:
+            self.quadratic = bool(quadratic)
+            self.beta = self._gls(X, y, L, self.quadratic)[0]
 
-    def _quadratic_pays(self, X: np.ndarray, y: np.ndarray, L: np.ndarray) -> bool:
-        """Whether the quadratic trend's 2d terms reduce the residuals' squared Mahalanobis norm by more than
-        2d·log n, the Bayesian information criterion's price of 2d parameters (twice its log-likelihood's)."""
-        self.quadratic = False
-        misfit_constant = self._gls(X, y, L)[1]
-        self.quadratic = True
-        misfit_quadratic = self._gls(X, y, L)[1]
-        return misfit_constant - misfit_quadratic > 2 * X.shape[1] * np.log(X.shape[0])
-
-    def _gls(self, X: np.ndarray, y: np.ndarray, L: np.ndarray) -> tuple[np.ndarray, float]:
-        """GLS coefficients of the current basis and the residual's squared Mahalanobis norm."""
-        F = self.basis(X)
+    def _gls(self, X: np.ndarray, y: np.ndarray, L: np.ndarray, quadratic: bool) -> tuple[np.ndarray, float]:
+        """GLS coefficients of the constant or quadratic basis and the residual's squared Mahalanobis norm."""
+        F = self._regressors(X, quadratic)
         KiF = cho_solve((L, True), F, check_finite=False)
         # Least squares: a variable every design shares (all on one face) leaves its columns at zero, and the
         # minimum-norm solution gives them no weight.
@@ -88,13 +85,16 @@ class Trend:
         r = y - F @ beta
         return beta, float(r @ cho_solve((L, True), r, check_finite=False))
 
-    def basis(self, U: np.ndarray) -> np.ndarray:
-        """The trend's regressors at designs U (m, d): 1, or 1, z_k and z_k² with z the centred, scaled U."""
+    def _regressors(self, U: np.ndarray, quadratic: bool) -> np.ndarray:
         U = np.atleast_2d(U)
-        if not self.quadratic:
+        if not quadratic:
             return np.ones((U.shape[0], 1))
         Z = (U - self.centre) / self.scale
         return np.hstack([np.ones((U.shape[0], 1)), Z, Z * Z])
+
+    def basis(self, U: np.ndarray) -> np.ndarray:
+        """The trend's regressors at designs U (m, d): 1, or 1, z_k and z_k² with z the centred, scaled U."""
+        return self._regressors(U, self.quadratic)
 
     def __call__(self, U: np.ndarray) -> np.ndarray:
         """The prior mean at designs U (m, d)."""

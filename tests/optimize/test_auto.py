@@ -272,6 +272,13 @@ def test_designs_a_hair_apart_factorise_with_jitter():
     np.testing.assert_allclose(mean, y[:5], atol=1e-4)
 
 
+def _matern52(A: np.ndarray, B: np.ndarray, ell) -> np.ndarray:
+    """Matérn-5/2 correlation of designs A and B, written out for the independent formulations below."""
+    D = (A[:, None, :] - B[None, :, :]) / ell
+    r = np.sqrt(np.sum(D * D, axis=2))
+    return (1 + np.sqrt(5) * r + 5 / 3 * r * r) * np.exp(-np.sqrt(5) * r)
+
+
 def test_mean_level_is_the_limit_of_a_random_constant_of_large_variance():
     # An independent formulation: a zero-mean GP whose kernel has a constant term B·11ᵀ predicts, as B grows, the
     # generalised least-squares level plus the kriging of the residuals (ordinary kriging, Santner et al. 2003).
@@ -283,9 +290,7 @@ def test_mean_level_is_the_limit_of_a_random_constant_of_large_variance():
     U = np.array([[0.05, 0.05], [0.5, 0.5], [0.95, 0.9], [3.0, 3.0]])
 
     def k(A, B):
-        D = (A[:, None, :] - B[None, :, :]) / np.exp(theta[:2])
-        r = np.sqrt(np.sum(D * D, axis=2))
-        return (1 + np.sqrt(5) * r + 5 / 3 * r * r) * np.exp(-np.sqrt(5) * r)
+        return _matern52(A, B, np.exp(theta[:2]))
 
     K, Ks, big = k(X, X) + 1e-6 * np.eye(12), k(U, X), 1e5
     mean, sd = gp.predict(U)
@@ -312,9 +317,7 @@ def test_quadratic_trend_is_the_limit_of_random_coefficients_of_large_variance()
         return np.hstack([np.ones((A.shape[0], 1)), A, A * A])
 
     def k(A, B):
-        D = (A[:, None, :] - B[None, :, :]) / 0.4
-        r = np.sqrt(np.sum(D * D, axis=2))
-        return (1 + np.sqrt(5) * r + 5 / 3 * r * r) * np.exp(-np.sqrt(5) * r)
+        return _matern52(A, B, 0.4)
 
     big = 1e6
     K = k(X, X) + 1e-6 * np.eye(14) + big * f(X) @ f(X).T
