@@ -119,6 +119,15 @@ def propose_batch(gp: GaussianProcess, best: float, lo: np.ndarray, hi: np.ndarr
     """``q`` designs of the box [lo, hi] (unit cube) maximising log EI + log P(success), one after the other, each
     chosen with the previous ones believed at their posterior mean (Ginsbourger et al. 2010).
 
+    A believed design is data: the incumbent becomes the least of it, and the believed value is exact
+    (:meth:`GaussianProcess.believe`).  With the incumbent left at the simulated designs' least, a design the model
+    expects below it kept its expected improvement for its neighbours, and up to 6 designs of a batch of 8 went
+    within 1e-3 of each other (Hartmann-6, 60 simulations).  Measured *ad hoc* (``auto_search`` at 60 simulations,
+    seeds 0-19, median gap % of the range and runs within 0.5 %, before -> after), batches of 4: cosine_bowl4 0.35
+    (10) -> 0.001 (17), Hartmann-6 0.31 (11) -> 0.005 (15), cosine_bowl3 0.0007 (18) -> 0.0004 (20); batches of 8:
+    cosine_bowl4 0.18 (11) -> 0.08 (13), Styblinski-Tang-3 0.0003 (17) -> 0.0001 (20), Hartmann-6 3.8 (5) -> 3.7
+    (6); Hartmann-3 all 20 either way.
+
     Parameters
     ----------
     gp : GaussianProcess
@@ -155,7 +164,7 @@ def propose_batch(gp: GaussianProcess, best: float, lo: np.ndarray, hi: np.ndarr
     chosen: list[np.ndarray] = []
     model = gp
     for _ in range(q):
-        def score(U: np.ndarray, model: GaussianProcess = model) -> np.ndarray:
+        def score(U: np.ndarray, model: GaussianProcess = model, best: float = best) -> np.ndarray:
             if kappa is None:
                 s = log_expected_improvement(model, U, best)
             else:
@@ -175,6 +184,9 @@ def propose_batch(gp: GaussianProcess, best: float, lo: np.ndarray, hi: np.ndarr
         chosen.append(x)
         if len(chosen) < q:
             model = model.believe(x[None, :])
+            # The believed value joins the data, and the incumbent is the least of the data (Ginsbourger et al.):
+            # a design believed below the incumbent is the one the next must improve on.
+            best = min(best, float(model.y[-1]))
     return np.array(chosen).reshape(-1, lo.size)
 
 

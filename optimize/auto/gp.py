@@ -138,10 +138,14 @@ class GaussianProcess:
     quadratic : bool, optional
         The prior mean's form (:class:`~mechopt.optimize.auto.trend.Trend`); default: quadratic where the designs
         pay for it (their number and the information criterion).
+    believed : int
+        How many of the last designs are a batch's believed values (:meth:`believe`), taken as exact.
     """
 
-    def __init__(self, X: np.ndarray, y: np.ndarray, theta: np.ndarray, quadratic: bool | None = None) -> None:
+    def __init__(self, X: np.ndarray, y: np.ndarray, theta: np.ndarray, quadratic: bool | None = None,
+                 believed: int = 0) -> None:
         self.X, self.y, self.theta = np.asarray(X, float), np.asarray(y, float), np.asarray(theta, float)
+        self.believed = int(believed)
         d = self.X.shape[1]
         self.signal, self.noise = math.exp(self.theta[d]), math.exp(self.theta[d + 1])
         if self.theta.size > d + 2:
@@ -150,7 +154,9 @@ class GaussianProcess:
         #: The designs' prior covariance (no noise), kept for :func:`_sees_no_neighbour`.
         self.K = _covariance(self.X, self.X, self.theta)
         K = self.K.copy()
-        K[np.diag_indices_from(K)] += self.noise
+        # A believed design is a value of the latent function, not a noisy simulation: no noise on its diagonal.
+        simulated = np.arange(self.X.shape[0] - self.believed)
+        K[simulated, simulated] += self.noise
         self.L = _cholesky(K, self.signal)
         #: The prior mean (generalised least squares).
         self.trend = Trend(self.X, self.y, self.L, quadratic)
@@ -183,11 +189,17 @@ class GaussianProcess:
         return self.trend(U) + Ks @ self.alpha + (F @ rng.standard_normal((U.shape[0], n))).T
 
     def believe(self, U: np.ndarray) -> GaussianProcess:
-        """The same GP with designs U (m, d) added at their posterior mean (the kriging believer of a batch)."""
+        """The same GP with designs U (m, d) added at their posterior mean (the kriging believer of a batch).
+
+        The believed values are of the latent function, exactly: its variance there is then zero, as it would be
+        after the simulation on a deterministic simulator.  With the noise of the simulated designs on them a fitted
+        nugget left most of the variance in place, and the next design of the batch could go next to the believed
+        one (the expected improvement of the latent function there is the same as before the first).
+        """
         U = np.atleast_2d(U)
         mean, _ = self.predict(U)
         return GaussianProcess(np.vstack([self.X, U]), np.concatenate([self.y, mean]), self.theta,
-                               self.trend.quadratic)
+                               self.trend.quadratic, self.believed + U.shape[0])
 
 
 def _inverse(L: np.ndarray) -> np.ndarray:
