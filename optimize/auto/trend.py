@@ -25,8 +25,7 @@ Styblinski-Tang-3 0.011 (16) -> 0.0088 (17) -> 0.043 (17), Hartmann-3 0.0005 (19
 (29).  The criterion is what keeps the constant on landscapes that are no bowl, which the trend always taken
 misled (12 seeds at 40 simulations, from ``benchmarks/bench_unseen.py``): Schwefel-4 7.1 -> 10.2 -> 7.1 %,
 Michalewicz-5 18.3 -> 24.5 -> 18.3 %; on Hartmann-3 with noise of 5 % of its range the criterion keeps the
-constant too.  Suite, peers and budgets
-up to 500: BENCHMARKS.md.
+constant too.  Suite, peers and budgets up to 500: BENCHMARKS.md.
 """
 
 from __future__ import annotations
