@@ -11,7 +11,7 @@ import os
 import time
 
 from mechopt.optimize.ground_truth import compute_ground_truth
-from mechopt.sim.fourbar.analytic import analytic_batch
+from mechopt.sim.four_bar.analytic import analytic_batch
 from mechopt.studies.catalogue import load_study
 
 
@@ -49,7 +49,7 @@ def basin_check(study, n_starts: int, seed: int = 5) -> str:
     import numpy as np
 
     from mechopt.optimize.ground_truth import polish
-    from mechopt.sim.fourbar.feasibility import feasible_mask
+    from mechopt.sim.four_bar.feasibility import feasible_mask
 
     rng = np.random.default_rng(seed)
     box = study.problem.bounds

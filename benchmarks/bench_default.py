@@ -33,7 +33,7 @@ if __package__ in (None, ""):
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from mechopt import minimize  # noqa: E402
-from mechopt.studies.test_functions import SUITE, TestFunction  # noqa: E402
+from mechopt.studies.benchmark_functions import SUITE, TestFunction  # noqa: E402
 
 #: Peers named by the issue: SMT EGO at small budgets, the library optimisers at large ones.
 PEERS = ("smt_ego", "nevergrad_ngopt", "pymoo_de", "optuna_tpe", "optuna_cmaes")

@@ -25,12 +25,12 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 from scipy.optimize import brentq
 
-from mechopt.sim.fourbar.analytic import simulate_analytic
-from mechopt.sim.fourbar.exudyn_engine import simulate_exudyn
-from mechopt.sim.fourbar.feasibility import check_feasibility
-from mechopt.sim.fourbar.kinematics import crank_angle
-from mechopt.sim.fourbar.pymunk_engine import simulate_pymunk
-from mechopt.sim.fourbar.simulate import simulate
+from mechopt.sim.four_bar.analytic import simulate_analytic
+from mechopt.sim.four_bar.exudyn_engine import simulate_exudyn
+from mechopt.sim.four_bar.feasibility import check_feasibility
+from mechopt.sim.four_bar.kinematics import crank_angle
+from mechopt.sim.four_bar.pymunk_engine import simulate_pymunk
+from mechopt.sim.four_bar.simulate import simulate
 from mechopt.studies.catalogue import load_study
 
 

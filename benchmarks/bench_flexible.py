@@ -15,7 +15,7 @@ import time
 
 import numpy as np
 
-from mechopt.sim.flexible import FlexibleSliderCrank, simulate
+from mechopt.sim.flexible_slider_crank import FlexibleSliderCrank, simulate
 
 
 def _rel(x: np.ndarray, ref: np.ndarray) -> float:

@@ -18,8 +18,8 @@ import numpy as np
 
 from mechopt.errors import InfeasibleDesignError
 from mechopt.optimize.baselines import BASELINES, CountedProblem
-from mechopt.sim.fourbar.analytic import simulate_analytic
-from mechopt.sim.fourbar.feasibility import check_feasibility
+from mechopt.sim.four_bar.analytic import simulate_analytic
+from mechopt.sim.four_bar.feasibility import check_feasibility
 from mechopt.studies.catalogue import load_study
 
 #: Brute-force optimum of the ventilator (analytic engine, 1 mm grid + SLSQP polish), N·m.

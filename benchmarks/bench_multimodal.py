@@ -1,6 +1,6 @@
 """Benchmark of the global sparse strategy (optimize/sparse_global.py) on the multimodal suite and the ventilator.
 
-For every suite function (studies/test_functions.py) and budget, 10 seeds of
+For every suite function (studies/benchmark_functions.py) and budget, 10 seeds of
 
 * ``sparse``: :func:`mechopt.optimize.sparse_global.global_search` (lines, blend, basins, steps on the corrected
   blend);
@@ -40,7 +40,7 @@ from mechopt.errors import InfeasibleDesignError  # noqa: E402
 from mechopt.optimize.auto import auto_search  # noqa: E402
 from mechopt.optimize.budget import CountedProblem  # noqa: E402
 from mechopt.optimize.sparse_global import global_search  # noqa: E402
-from mechopt.studies.test_functions import SUITE, TestFunction  # noqa: E402
+from mechopt.studies.benchmark_functions import SUITE, TestFunction  # noqa: E402
 
 #: Issue 15's bar is set at 300 evaluations in 3-D and 150 in 2-D: larger budgets are not run in 2-D.
 MAX_BUDGET_2D = 150
@@ -155,7 +155,7 @@ def suite_table(budgets: list[int], n_seeds: int, ego: bool, names: list[str] | 
 
 
 def ventilator(budgets: list[int], n_seeds: int) -> None:
-    from mechopt.sim.fourbar.analytic import analytic_batch
+    from mechopt.sim.four_bar.analytic import analytic_batch
     from mechopt.studies.catalogue import load_study
 
     problem = load_study("ventilator", {"engine": "analytic"}).problem

@@ -41,8 +41,8 @@ from mechopt.optimize.minimize import _options, run_method  # noqa: E402
 from mechopt.optimize.sparse.sampler import Sampler  # noqa: E402
 from mechopt.runs.executors import InProcessExecutor  # noqa: E402
 from mechopt.runs.store import SampleStore  # noqa: E402
+from mechopt.studies.benchmark_functions import SUITE  # noqa: E402
 from mechopt.studies.catalogue import load_study  # noqa: E402
-from mechopt.studies.test_functions import SUITE  # noqa: E402
 
 #: The simulator: a suite function in pure Python after a sleep, design JSON on stdin, outputs JSON on stdout.
 SIM = '''import json, math, sys, time

@@ -30,7 +30,7 @@ import mechopt
 from mechopt.cli.compare import ego_max_budget
 from mechopt.optimize.baselines import BASELINES, LIBRARY_BASELINES
 from mechopt.optimize.problem import Variable
-from mechopt.studies.test_functions import SUITE, TestFunction
+from mechopt.studies.benchmark_functions import SUITE, TestFunction
 
 #: The points of the issue: (dimension, budget, suite function).
 POINTS = [(3, 30, "hartmann3"), (3, 300, "hartmann3"), (6, 300, "hartmann6"), (8, 500, "levy8"),

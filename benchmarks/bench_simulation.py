@@ -14,9 +14,9 @@ import time
 
 import numpy as np
 
-from mechopt.sim.fourbar.analytic import analytic_batch, simulate_analytic
-from mechopt.sim.fourbar.feasibility import feasible_mask
-from mechopt.sim.fourbar.pymunk_engine import simulate_pymunk
+from mechopt.sim.four_bar.analytic import analytic_batch, simulate_analytic
+from mechopt.sim.four_bar.feasibility import feasible_mask
+from mechopt.sim.four_bar.pymunk_engine import simulate_pymunk
 from mechopt.studies.catalogue import load_study
 
 

@@ -29,7 +29,7 @@ if __package__ in (None, ""):
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from mechopt import minimize  # noqa: E402
-from mechopt.studies.test_functions import SUITE, TestFunction, Variable  # noqa: E402
+from mechopt.studies.benchmark_functions import SUITE, TestFunction, Variable  # noqa: E402
 
 
 def michalewicz(X: np.ndarray) -> np.ndarray:

@@ -44,8 +44,8 @@ def study_lines() -> list[str]:
     The study files are read as TOML only: building a study's problem can cost seconds (the ventilator's
     reconstruction), and a list needs none of it.
     """
+    from mechopt.studies.benchmark_functions import SUITE
     from mechopt.studies.catalogue import STUDIES_DIR
-    from mechopt.studies.test_functions import SUITE
 
     rows = []
     for path in sorted(STUDIES_DIR.glob("*/study.toml")):
@@ -103,8 +103,8 @@ def _copy_shared_data(folder: Path, to: Path) -> list[str]:
 
 def run_init(args: argparse.Namespace, rest: list[str]) -> int:
     """Copy a packaged study's files into a new folder."""
+    from mechopt.studies.benchmark_functions import SUITE
     from mechopt.studies.catalogue import STUDIES_DIR, packaged_studies
-    from mechopt.studies.test_functions import SUITE
 
     files = packaged_studies()
     if args.name in SUITE:

@@ -51,7 +51,7 @@ def _raise_terminated(_signum: int, _frame: object) -> None:
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``mechopt`` with all its subcommands."""
     from mechopt import __version__
-    from mechopt.sim.fourbar.simulate import ENGINES
+    from mechopt.sim.four_bar.simulate import ENGINES
 
     parser = Parser(prog="mechopt",
                     description="Globally optimal mechanism dimensions from few motion simulations (lengths in mm).")

@@ -25,10 +25,10 @@ from mechopt.optimize.arguments import check_method
 from mechopt.optimize.ground_truth import GroundTruth, load_or_compute
 from mechopt.optimize.minimize import checked_options, parallel_accounting, run_method
 from mechopt.optimize.result import OptimizeResult
+from mechopt.optimize.sparse.model_confidence import study_trust
 from mechopt.optimize.sparse.options import SparseOptions
 from mechopt.optimize.sparse.sampler import Sampler
 from mechopt.optimize.sparse.space import ModelSpace
-from mechopt.optimize.sparse.trust import study_trust
 from mechopt.optimize.sparse.validate import Validation, validate
 from mechopt.runs.executors import check_reachable, default_workers, make_executor
 from mechopt.runs.store import SampleStore

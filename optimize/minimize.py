@@ -25,11 +25,11 @@ from mechopt.optimize.arguments import (
 )
 from mechopt.optimize.problem import DesignProblem
 from mechopt.optimize.result import OptimizeResult
+from mechopt.optimize.sparse.model_confidence import study_trust
 from mechopt.optimize.sparse.options import SparseOptions
 from mechopt.optimize.sparse.pipeline import run_pipeline
 from mechopt.optimize.sparse.sampler import Sampler
 from mechopt.optimize.sparse.space import ModelSpace
-from mechopt.optimize.sparse.trust import study_trust
 from mechopt.optimize.sparse.validate import validate
 from mechopt.runs.executors import make_executor
 from mechopt.runs.store import SampleStore

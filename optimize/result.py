@@ -36,7 +36,7 @@ class OptimizeResult(_ScipyResult):
         Held-out lines against the model (sparse method, when asked for).
     trust : dict
         Whether the line model resolves the landscape, and where the answer came from (``verdict``: one
-        sentence; studies and ``"sparse-global"``; :func:`mechopt.optimize.sparse.trust.study_trust`).
+        sentence; studies and ``"sparse-global"``; :func:`mechopt.optimize.sparse.model_confidence.study_trust`).
     sampling : dict
         Counts, the executor used and the timing of :meth:`mechopt.optimize.sparse.sampler.Sampler.timing`.
     rounds : int

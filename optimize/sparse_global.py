@@ -38,8 +38,8 @@ from typing import Any
 import numpy as np
 
 from mechopt.errors import InputError
+from mechopt.optimize.sparse.model_confidence import RESOLVED
 from mechopt.optimize.sparse.model_exploration import DISTANCE_CYCLE, explore
-from mechopt.optimize.sparse.trust import RESOLVED
 from mechopt.surrogate import LinePlan, SparseExponentialModel, SurrogateError, exhaustive_search, plan_lines
 from mechopt.surrogate.basins import Minima, field_minima, thin
 from mechopt.surrogate.errors import SurrogateWarning

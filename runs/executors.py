@@ -3,7 +3,7 @@
 Every executor offers :meth:`SampleExecutor.map_unordered`, an iterator of results in completion order.  At
 most :attr:`SampleExecutor.max_in_flight` items (``workers`` plus an optional ``prefetch``, default 0) are
 outstanding at any time, and the next item is only submitted once the consumer has taken a result (and, in
-:mod:`studies.sampling`, committed it to the store).  So a run killed at any moment has lost at most
+:mod:`runs.sampling`, committed it to the store).  So a run killed at any moment has lost at most
 ``max_in_flight`` computations, and workers never race far ahead of what is saved.  ``prefetch`` trades that
 bound for throughput: each worker then has its next item queued while its result travels back (5–10 % more
 throughput for 10 ms simulations on 2 local processes).

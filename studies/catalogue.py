@@ -100,19 +100,19 @@ def packaged_studies() -> list[str]:
 
 def available_studies() -> list[str]:
     """Names of the studies shipped with mechopt (and of the multimodal test functions, for ``mechopt compare``)."""
-    from mechopt.studies.test_functions import SUITE
+    from mechopt.studies.benchmark_functions import SUITE
 
     return packaged_studies() + sorted(SUITE)
 
 
 def _suite_study(name: str) -> Study | None:
     """A test function of the multimodal suite as a study (no file: its problem is a class)."""
-    from mechopt.studies import test_functions
+    from mechopt.studies import benchmark_functions
 
-    cls = test_functions.SUITE.get(name)
+    cls = benchmark_functions.SUITE.get(name)
     if cls is None:
         return None
-    return Study(name=name, path=Path(test_functions.__file__), description=cls.summary(), kind="test-function",
+    return Study(name=name, path=Path(benchmark_functions.__file__), description=cls.summary(), kind="test-function",
                  problem=cls())
 
 

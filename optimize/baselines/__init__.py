@@ -3,13 +3,13 @@
 Every baseline has the signature ``minimize_<name>(problem: CountedProblem, seed: int, **options) ->
 OptimizeResult`` and returns the best *feasible* design it simulated (``x``, ``fun``) with the number of simulator
 calls used (``nfev <= problem.budget``); :class:`~mechopt.optimize.budget.CountedProblem` enforces the budget.
-:func:`~studies.baselines.rbf_surrogate.fit_and_search_rbf` is the surrogate baseline fed with given samples; it is
+:func:`~optimize.baselines.rbf_surrogate.fit_and_search_rbf` is the surrogate baseline fed with given samples; it is
 not in :data:`BASELINES` because it does not choose its own samples.
 
 :data:`BASELINES` holds the in-house implementations (:data:`IN_HOUSE_BASELINES`) and wrappers of maintained optimizer
 libraries (:data:`LIBRARY_BASELINES`: Optuna, SMT, pymoo, nevergrad).  The libraries are the optional ``compare``
 extra, imported only when their baseline runs; a missing one raises
-:class:`~studies.baselines.library.MissingLibraryError` with a one-line message.
+:class:`~optimize.baselines.library.MissingLibraryError` with a one-line message.
 """
 
 from __future__ import annotations

@@ -15,7 +15,7 @@ until :class:`CountedProblem` has spent the budget.
 Constraint handling: nevergrad's own cheap-constraint mechanism.  The feasibility test is registered with
 ``register_cheap_constraint``: ``ask`` resamples (then runs a small constraint-satisfaction search) until the
 candidate is feasible, and nevergrad penalises a violating candidate in ``tell``.  A candidate still infeasible
-after that is not simulated; it is told :func:`~studies.baselines.library.rejected_value` (above every simulated
+after that is not simulated; it is told :func:`~optimize.baselines.library.rejected_value` (above every simulated
 value, growing with the violation), to which nevergrad adds its own penalty.  A failed simulation is told the same
 value.
 

@@ -23,7 +23,7 @@ warns when they are set), so they are handled outside it, by one of two document
   completed trials towards a generation, so the next ask draws a fresh candidate from the same search distribution --
   Hansen's resampling of infeasible solutions.
 * ``"penalty"`` (default): an infeasible design is not simulated and is told as completed with the value of
-  :func:`~studies.baselines.library.rejected_value` (above every simulated value, growing with the violation), so it
+  :func:`~optimize.baselines.library.rejected_value` (above every simulated value, growing with the violation), so it
   ranks last in its generation.
 
 The penalty is the default because the optima of mechanism problems sit on constraints: on the test problem whose

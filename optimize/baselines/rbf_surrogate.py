@@ -2,7 +2,7 @@
 
 The classic surrogate-based alternative to the project's sparse interpolation, fed with the very same samples:
 ``scipy.interpolate.RBFInterpolator`` (thin-plate spline by default) or the package's Matérn-5/2 Gaussian process
-(Kriging, :class:`studies.baselines.bayesian.GaussianProcess`), both on the unit cube of the box.  The surrogate is
+(Kriging, :class:`optimize.baselines.bayesian.GaussianProcess`), both on the unit cube of the box.  The surrogate is
 minimised over a dense scrambled Sobol' set inside the box, kept to the cheap feasible region and, on request, to
 the convex hull of the samples (where the surrogate interpolates instead of extrapolating), then polished by
 Nelder-Mead on the surrogate under the same restrictions.

@@ -9,8 +9,8 @@ from __future__ import annotations
 from typing import Any
 
 from mechopt.errors import InputError, StudyError
-from mechopt.sim.flexible import ENGINES, MM, FlexibleSliderCrank
-from mechopt.sim.flexible.problem import DEFAULT_BOUNDS, FlexibleSliderCrankProblem
+from mechopt.sim.flexible_slider_crank import ENGINES, MM, FlexibleSliderCrank
+from mechopt.sim.flexible_slider_crank.problem import DEFAULT_BOUNDS, FlexibleSliderCrankProblem
 from mechopt.studies.study_file import StudyFile
 
 __all__ = ["problem_from_study"]

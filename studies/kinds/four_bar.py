@@ -1,4 +1,4 @@
-"""A four-bar study file read into a :class:`~mechopt.sim.fourbar.problem.FourBarProblem`.
+"""A four-bar study file read into a :class:`~mechopt.sim.four_bar.problem.FourBarProblem`.
 
 Sections read here: ``[mechanism]`` (kind-specific keys), ``[reconstruction]`` (when the ground pivot and inertias
 are fitted to a motor-side table), ``[motion]``, ``[load]`` and ``[sampling]``.  Lengths in mm, angles in degrees,
@@ -14,13 +14,13 @@ from typing import Any
 import numpy as np
 
 from mechopt.errors import MechoptError, StudyError
-from mechopt.sim.fourbar.kinematics import BRANCH_ADD, BRANCH_SUBTRACT
-from mechopt.sim.fourbar.load import RockerLoad
-from mechopt.sim.fourbar.mechanism import FourBar
-from mechopt.sim.fourbar.motion import LAW_CODES, MotionLaw
-from mechopt.sim.fourbar.problem import FourBarProblem
-from mechopt.sim.fourbar.reconstruction import read_motor_table, reconstruct
-from mechopt.sim.fourbar.simulate import ENGINES
+from mechopt.sim.four_bar.kinematics import BRANCH_ADD, BRANCH_SUBTRACT
+from mechopt.sim.four_bar.load import RockerLoad
+from mechopt.sim.four_bar.mechanism import FourBar
+from mechopt.sim.four_bar.motion import LAW_CODES, MotionLaw
+from mechopt.sim.four_bar.problem import FourBarProblem
+from mechopt.sim.four_bar.reconstruction import read_motor_table, reconstruct
+from mechopt.sim.four_bar.simulate import ENGINES
 from mechopt.studies.study_file import StudyFile
 
 __all__ = ["problem_from_study"]

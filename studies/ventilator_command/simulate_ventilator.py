@@ -39,7 +39,7 @@ NAMES = ("oa", "ab", "bc")  # |OA|, |AB|, |BC| in mm
 
 def _cache_file(engine: str) -> Path:
     """Where the reconstructed problem is kept: named by the hash of every file that shapes it."""
-    import mechopt.sim.fourbar as fourbar
+    import mechopt.sim.four_bar as fourbar
 
     digest = hashlib.sha256(engine.encode())
     shipped = STUDIES_DIR / "ventilator"

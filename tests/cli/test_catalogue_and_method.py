@@ -10,8 +10,8 @@ import mechopt
 from mechopt.cli.main import EXIT_ERROR, main
 from mechopt.errors import InputError
 from mechopt.optimize.arguments import available_methods
+from mechopt.studies.benchmark_functions import Hartmann3
 from mechopt.studies.catalogue import available_studies
-from mechopt.studies.test_functions import Hartmann3
 
 
 def test_version(capsys):
@@ -92,8 +92,8 @@ def test_a_line_model_method_refuses_more_than_four_variables_in_cli_terms():
 
 def test_test_function_descriptions_are_whole_sentences_without_markup():
     # The first docstring line cut failing_hartmann3's sentence in two and kept its ``evaluate``.
+    from mechopt.studies.benchmark_functions import SUITE
     from mechopt.studies.catalogue import load_study
-    from mechopt.studies.test_functions import SUITE
 
     for name, cls in SUITE.items():
         text = cls.summary()

@@ -14,7 +14,7 @@ from mechopt.optimize.auto.acquisition import propose_batch
 from mechopt.optimize.auto.gp import GaussianProcess, _median_spacing, _neg_log_posterior, _sees_no_neighbour, fit_gp
 from mechopt.optimize.auto.transform import standardise
 from mechopt.optimize.problem import DesignProblem, Variable
-from mechopt.studies.test_functions import SUITE, FailingHartmann3, Hartmann3, Hartmann6
+from mechopt.studies.benchmark_functions import SUITE, FailingHartmann3, Hartmann3, Hartmann6
 
 
 class Quadratic(DesignProblem):

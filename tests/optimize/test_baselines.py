@@ -1,4 +1,4 @@
-"""Tests of the budget-limited baseline optimizers (studies.baselines).
+"""Tests of the budget-limited baseline optimizers (optimize.baselines).
 
 Test problems (3-D, box [-2, 2]^3, both with constraints cutting part of the box):
 

@@ -3,7 +3,7 @@
 import pytest
 
 import mechopt
-from mechopt.studies.test_functions import SUITE
+from mechopt.studies.benchmark_functions import SUITE
 
 
 @pytest.mark.parametrize("method", ["auto", "sparse", "sparse-global"])
@@ -106,7 +106,7 @@ def test_failures_scattered_among_successes_leave_the_landscape_as_it_is():
     import numpy as np
 
     from mechopt.optimize.auto.search import auto_search
-    from mechopt.studies.test_functions import Hartmann3
+    from mechopt.studies.benchmark_functions import Hartmann3
 
     f = Hartmann3()
 

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from mechopt.optimize.ground_truth import compute_ground_truth, load_or_compute
-from mechopt.sim.fourbar.analytic import analytic_batch
-from mechopt.sim.fourbar.feasibility import check_feasibility
-from mechopt.sim.fourbar.pymunk_engine import simulate_pymunk
+from mechopt.sim.four_bar.analytic import analytic_batch
+from mechopt.sim.four_bar.feasibility import check_feasibility
+from mechopt.sim.four_bar.pymunk_engine import simulate_pymunk
 
 
 @pytest.fixture(scope="module")

@@ -10,7 +10,7 @@ import pytest
 from mechopt import minimize
 from mechopt.errors import InputError
 from mechopt.optimize.arguments import method_min_budget
-from mechopt.studies.test_functions import Branin, Hartmann3, Hartmann4
+from mechopt.studies.benchmark_functions import Branin, Hartmann3, Hartmann4
 
 
 @pytest.mark.parametrize(("problem", "method", "need"), [

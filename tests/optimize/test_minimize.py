@@ -10,8 +10,8 @@ import pytest
 import mechopt
 from mechopt.runs.sampling import sample_designs
 from mechopt.runs.store import SampleStore
-from mechopt.sim.fourbar.load import RockerLoad
-from mechopt.sim.fourbar.problem import FourBarProblem
+from mechopt.sim.four_bar.load import RockerLoad
+from mechopt.sim.four_bar.problem import FourBarProblem
 
 #: The ventilator's true optimum, T_RMS in N·m (brute force: see test_ground_truth.py).
 T_TRUE = 1.7582
@@ -155,7 +155,7 @@ def test_studies_that_differ_only_in_the_load_or_the_toggle_margin_never_share_s
 
 
 def test_trust_report_says_whether_the_model_resolves_the_landscape():
-    from mechopt.studies.test_functions import Hartmann3
+    from mechopt.studies.benchmark_functions import Hartmann3
 
     # A smooth bowl cut by a disc: 7 lines resolve it, the model's claim and its leave-one-line-out error agree.
     smooth = mechopt.minimize(Bracket(), budget=200, method="sparse", seed=1)

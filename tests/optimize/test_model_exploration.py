@@ -73,7 +73,7 @@ def test_failed_simulations_are_not_modelled_nor_repeated():
 
 
 def _failing_hartmann3(z):
-    from mechopt.studies.test_functions import FailingHartmann3
+    from mechopt.studies.benchmark_functions import FailingHartmann3
 
     f = FailingHartmann3()
     return float("nan") if z[0] > f.raise_above or z[1] > f.nan_above else float(f.function(z[None, :])[0])

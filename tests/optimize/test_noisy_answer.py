@@ -8,7 +8,7 @@ from mechopt.optimize.auto.answer import lowest_mean
 from mechopt.optimize.auto.gp import fit_gp
 from mechopt.optimize.auto.search import auto_search
 from mechopt.optimize.auto.transform import standardise
-from mechopt.studies.test_functions import Hartmann3, NoisyHartmann6
+from mechopt.studies.benchmark_functions import Hartmann3, NoisyHartmann6
 
 
 def _hash_noise(X: np.ndarray) -> np.ndarray:

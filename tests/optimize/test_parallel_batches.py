@@ -21,8 +21,8 @@ from mechopt.optimize.sparse.stage import build_stage
 from mechopt.optimize.sparse.trust_region import trust_region_steps
 from mechopt.runs.executors import InProcessExecutor
 from mechopt.runs.store import SampleStore
+from mechopt.studies.benchmark_functions import Branin
 from mechopt.studies.catalogue import load_study
-from mechopt.studies.test_functions import Branin
 
 SIM = """\
 import json, math, sys

@@ -1,4 +1,4 @@
-"""The multimodal suite (studies.test_functions) and the global sparse strategy (studies.sparse_global)."""
+"""The multimodal suite (studies.benchmark_functions) and the global sparse strategy (studies.sparse_global)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 
 from mechopt.errors import InputError
 from mechopt.optimize.sparse_global import global_search
-from mechopt.studies.test_functions import (
+from mechopt.studies.benchmark_functions import (
     SUITE,
     CosineBowl3,
     Hartmann3,

@@ -440,7 +440,7 @@ def test_a_script_that_starts_workers_without_a_main_guard_is_told_why_they_died
     script = tmp_path / "unguarded.py"
     script.write_text(
         "import mechopt\n"
-        "from mechopt.studies.test_functions import Hartmann3\n"
+        "from mechopt.studies.benchmark_functions import Hartmann3\n"
         "mechopt.minimize(Hartmann3(), budget=10, seed=0, workers=2)\n"
     )
     proc = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120,

@@ -5,8 +5,8 @@ import dataclasses
 import numpy as np
 import pytest
 
-from mechopt.sim.fourbar.analytic import analytic_batch, simulate_analytic, torque_curve
-from mechopt.sim.fourbar.kinematics import crank_angle, joint_positions
+from mechopt.sim.four_bar.analytic import analytic_batch, simulate_analytic, torque_curve
+from mechopt.sim.four_bar.kinematics import crank_angle, joint_positions
 
 
 def _energy(design_mm, mech, t):

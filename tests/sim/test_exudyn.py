@@ -14,11 +14,11 @@ import pytest
 from scipy.optimize import brentq
 
 from mechopt.errors import InfeasibleDesignError, InputError, MechoptError
-from mechopt.sim.fourbar.analytic import simulate_analytic, torque_curve
-from mechopt.sim.fourbar.exudyn_engine import simulate_exudyn
-from mechopt.sim.fourbar.feasibility import check_feasibility
-from mechopt.sim.fourbar.kinematics import crank_angle
-from mechopt.sim.fourbar.simulate import ENGINES, simulate
+from mechopt.sim.four_bar.analytic import simulate_analytic, torque_curve
+from mechopt.sim.four_bar.exudyn_engine import simulate_exudyn
+from mechopt.sim.four_bar.feasibility import check_feasibility
+from mechopt.sim.four_bar.kinematics import crank_angle
+from mechopt.sim.four_bar.simulate import ENGINES, simulate
 
 pytest.importorskip("exudyn")
 

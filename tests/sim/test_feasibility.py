@@ -5,11 +5,11 @@ import pytest
 from scipy.optimize import brentq
 
 from mechopt.errors import InfeasibleDesignError
-from mechopt.sim.fourbar.feasibility import check_feasibility, feasible_mask, require_movable
-from mechopt.sim.fourbar.kinematics import crank_angle
-from mechopt.sim.fourbar.load import RockerLoad
-from mechopt.sim.fourbar.mechanism import FourBar
-from mechopt.sim.fourbar.motion import MotionLaw
+from mechopt.sim.four_bar.feasibility import check_feasibility, feasible_mask, require_movable
+from mechopt.sim.four_bar.kinematics import crank_angle
+from mechopt.sim.four_bar.load import RockerLoad
+from mechopt.sim.four_bar.mechanism import FourBar
+from mechopt.sim.four_bar.motion import MotionLaw
 
 
 def _straddle(mechanism, column, base, index, lo, hi):

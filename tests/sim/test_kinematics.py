@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from mechopt.errors import InputError
-from mechopt.sim.fourbar.kinematics import check_design, crank_angle, joint_positions, rocker_angle
-from mechopt.sim.fourbar.pymunk_engine import simulate_pymunk
+from mechopt.sim.four_bar.kinematics import check_design, crank_angle, joint_positions, rocker_angle
+from mechopt.sim.four_bar.pymunk_engine import simulate_pymunk
 
 
 def test_parallelogram_by_hand():

@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from mechopt.sim.fourbar.analytic import MM, simulate_analytic, torque_curve
-from mechopt.sim.fourbar.feasibility import check_feasibility
-from mechopt.sim.fourbar.kinematics import crank_angle
-from mechopt.sim.fourbar.pymunk_engine import _run, simulate_pymunk
+from mechopt.sim.four_bar.analytic import MM, simulate_analytic, torque_curve
+from mechopt.sim.four_bar.feasibility import check_feasibility
+from mechopt.sim.four_bar.kinematics import crank_angle
+from mechopt.sim.four_bar.pymunk_engine import _run, simulate_pymunk
 
 
 def _boundary_design(mechanism, base, distance_mm):

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from mechopt.sim.fourbar.analytic import simulate_analytic
-from mechopt.sim.fourbar.pymunk_engine import simulate_pymunk
+from mechopt.sim.four_bar.analytic import simulate_analytic
+from mechopt.sim.four_bar.pymunk_engine import simulate_pymunk
 
 
 def test_reconstruction_matches_the_data_readme(ventilator):
@@ -25,8 +25,8 @@ def test_reconstruction_matches_the_data_readme(ventilator):
 
 
 def test_reconstructed_inertia_reproduces_the_table(ventilator):
-    from mechopt.sim.fourbar.kinematics import rocker_angle
-    from mechopt.sim.fourbar.reconstruction import read_motor_table
+    from mechopt.sim.four_bar.kinematics import rocker_angle
+    from mechopt.sim.four_bar.reconstruction import read_motor_table
 
     rec = ventilator.problem.reconstruction
     table = read_motor_table(ventilator.path.parent / "original_design_load_inertia.csv")

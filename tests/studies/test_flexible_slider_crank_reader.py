@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from mechopt.errors import StudyError
-from mechopt.sim.flexible.problem import FlexibleSliderCrankProblem
+from mechopt.sim.flexible_slider_crank.problem import FlexibleSliderCrankProblem
 from mechopt.studies.kinds.flexible_slider_crank import problem_from_study
 from mechopt.studies.study_file import PACKAGED_STUDIES, StudyFile
 
@@ -75,7 +75,7 @@ def test_figures_are_written(tmp_path: Path):
 
 
 def test_buckling_margin_separates_the_buckled_corner(problem):
-    from mechopt.sim.flexible import FlexibleSliderCrank, simulate
+    from mechopt.sim.flexible_slider_crank import FlexibleSliderCrank, simulate
 
     m = problem.margins(np.array([[50.0, 350.0, 1.53075], [76.1, 444.76, 1.003]]))[:, 0]
     assert m[0] > 0.5 and m[1] < 0.0

@@ -5,12 +5,12 @@ issue's 0.5 % (Eq. 18) on every response."""
 import numpy as np
 import pytest
 
-from mechopt.sim.flexible.response import normalised_error
 from mechopt.sim.flexible_four_bar import FlexibleFourBar, simulate
 from mechopt.sim.flexible_four_bar.kinematics import crank_rocker_margins
 from mechopt.sim.flexible_four_bar.loads import euler_load_ratios
 from mechopt.sim.flexible_four_bar.problem import ALL_VARIABLES, PAPER_BOUNDS
 from mechopt.sim.flexible_four_bar.response import path_error
+from mechopt.sim.flexible_slider_crank.response import normalised_error
 
 #: Largest axial compression over the Euler load of the designs compared (20 of the first 40 crank-rockers drawn;
 #: of the other 20, those at 0.28, 0.29 and 0.44 agree to 0.55 %, 0.45 % and 0.42 %, the 17 at 0.47-254 part by

@@ -31,12 +31,12 @@ import time
 import numpy as np
 import pymunk
 
-from mechopt.sim.fourbar.analytic import MM
-from mechopt.sim.fourbar.feasibility import require_movable
-from mechopt.sim.fourbar.kinematics import check_design, crank_angle
-from mechopt.sim.fourbar.load import _load_at
-from mechopt.sim.fourbar.mechanism import FourBar
-from mechopt.sim.fourbar.result import SimulationResult, rms_over_cycle
+from mechopt.sim.four_bar.analytic import MM
+from mechopt.sim.four_bar.feasibility import require_movable
+from mechopt.sim.four_bar.kinematics import check_design, crank_angle
+from mechopt.sim.four_bar.load import _load_at
+from mechopt.sim.four_bar.mechanism import FourBar
+from mechopt.sim.four_bar.result import SimulationResult, rms_over_cycle
 
 #: Moment of inertia of the stator (kg·m²): large, so that it barely turns within one step, yet its angular velocity
 #: keeps ~13 significant digits of the motor's reaction impulse.

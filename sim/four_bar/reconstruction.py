@@ -17,8 +17,8 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from mechopt.errors import StudyError
-from mechopt.sim.fourbar.kinematics import crank_angle, rocker_angle
-from mechopt.sim.fourbar.load import RockerLoad
+from mechopt.sim.four_bar.kinematics import crank_angle, rocker_angle
+from mechopt.sim.four_bar.load import RockerLoad
 
 
 @dataclass(frozen=True)

@@ -4,8 +4,8 @@ limit against closed-form kinematics, and the modal model's convergence and κ =
 import numpy as np
 import pytest
 
-from mechopt.sim.flexible import FlexibleSliderCrank, simulate
-from mechopt.sim.flexible.kinematics import rigid_motion
+from mechopt.sim.flexible_slider_crank import FlexibleSliderCrank, simulate
+from mechopt.sim.flexible_slider_crank.kinematics import rigid_motion
 
 
 def _rel(x, ref):

@@ -7,8 +7,8 @@ Two engines compute the slider velocity V(t), acceleration A(t) and the rod's mi
 the paper's normalised error (Eq. 18).
 """
 
-from mechopt.sim.flexible.parameters import MM, FlexibleSliderCrank
-from mechopt.sim.flexible.response import Response, normalised_error
-from mechopt.sim.flexible.simulate import ENGINES, simulate
+from mechopt.sim.flexible_slider_crank.parameters import MM, FlexibleSliderCrank
+from mechopt.sim.flexible_slider_crank.response import Response, normalised_error
+from mechopt.sim.flexible_slider_crank.simulate import ENGINES, simulate
 
 __all__ = ["ENGINES", "MM", "FlexibleSliderCrank", "Response", "normalised_error", "simulate"]

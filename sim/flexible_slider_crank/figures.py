@@ -11,8 +11,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from PIL import Image  # noqa: E402
 
-from mechopt.sim.flexible import MM, FlexibleSliderCrank, Response  # noqa: E402
-from mechopt.sim.flexible.kinematics import rigid_motion  # noqa: E402
+from mechopt.sim.flexible_slider_crank import MM, FlexibleSliderCrank, Response  # noqa: E402
+from mechopt.sim.flexible_slider_crank.kinematics import rigid_motion  # noqa: E402
 
 __all__ = ["animate_rod", "plot_responses"]
 

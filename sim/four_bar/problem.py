@@ -1,6 +1,6 @@
 """The four-bar as a design problem: (|OA|, |AB|, |BC|) in mm, T_RMS of the motor torque minimised.
 
-:class:`FourBarProblem` binds a :class:`~mechopt.sim.fourbar.mechanism.FourBar` (everything but the three lengths)
+:class:`FourBarProblem` binds a :class:`~mechopt.sim.four_bar.mechanism.FourBar` (everything but the three lengths)
 and an engine to mechopt's design-problem protocol: the five feasibility margins as constraints, the torque
 simulation as evaluator, and every number of the mechanism in the fingerprint (the whole load table, the toggle
 margin, the engine) so that a changed study never reuses another's samples.
@@ -17,9 +17,9 @@ import numpy as np
 
 from mechopt.errors import InputError
 from mechopt.optimize.problem import DesignProblem, Variable
-from mechopt.sim.fourbar.feasibility import MARGIN_NAMES, N_CHECK, check_feasibility, constraint_margins
-from mechopt.sim.fourbar.mechanism import FourBar
-from mechopt.sim.fourbar.simulate import ENGINES, simulate
+from mechopt.sim.four_bar.feasibility import MARGIN_NAMES, N_CHECK, check_feasibility, constraint_margins
+from mechopt.sim.four_bar.mechanism import FourBar
+from mechopt.sim.four_bar.simulate import ENGINES, simulate
 
 __all__ = ["ENGINE_VERSIONS", "FourBarProblem"]
 
@@ -95,7 +95,7 @@ class FourBarProblem(DesignProblem):
 
     def evaluate_batch(self, X: np.ndarray) -> np.ndarray:
         """T_RMS (N·m) of many designs (n, 3) by the analytic engine (numba), for brute-force ground truths."""
-        from mechopt.sim.fourbar.analytic import analytic_batch
+        from mechopt.sim.four_bar.analytic import analytic_batch
 
         t_rms, _ = analytic_batch(np.atleast_2d(np.asarray(X, dtype=float)), self.mechanism, check=False)
         return t_rms
@@ -148,7 +148,7 @@ class FourBarProblem(DesignProblem):
 
     def figures(self, designs: Mapping[str, np.ndarray], out: Path) -> dict[str, Path]:
         """Torque over the cycle of every design, the mechanisms at ψ_start and ψ_end, the optimum's cycle (GIF)."""
-        from mechopt.sim.fourbar.figures import animate_cycle, plot_mechanisms, plot_torque_comparison
+        from mechopt.sim.four_bar.figures import animate_cycle, plot_mechanisms, plot_torque_comparison
 
         results = {name: simulate(np.asarray(x, float), self.mechanism, engine=self.engine)
                    for name, x in designs.items()}

@@ -22,8 +22,8 @@ import numpy as np
 from numba import njit, prange
 
 from mechopt.errors import InfeasibleDesignError, InputError
-from mechopt.sim.fourbar.kinematics import _crank_kernel
-from mechopt.sim.fourbar.mechanism import FourBar
+from mechopt.sim.four_bar.kinematics import _crank_kernel
+from mechopt.sim.four_bar.mechanism import FourBar
 
 #: ψ samples along the stroke at which the along-stroke constraints are checked.
 N_CHECK = 241

@@ -19,11 +19,11 @@ import time
 import numpy as np
 from numba import njit, prange
 
-from mechopt.sim.fourbar.feasibility import as_designs, check_feasibility, require_movable
-from mechopt.sim.fourbar.kinematics import _crank_kernel, check_design, crank_angle
-from mechopt.sim.fourbar.load import _load_at
-from mechopt.sim.fourbar.mechanism import FourBar
-from mechopt.sim.fourbar.result import SimulationResult, rms_over_cycle
+from mechopt.sim.four_bar.feasibility import as_designs, check_feasibility, require_movable
+from mechopt.sim.four_bar.kinematics import _crank_kernel, check_design, crank_angle
+from mechopt.sim.four_bar.load import _load_at
+from mechopt.sim.four_bar.mechanism import FourBar
+from mechopt.sim.four_bar.result import SimulationResult, rms_over_cycle
 
 MM = 1e-3  # m per mm: the single place where the user's mm become the dynamics' metres
 

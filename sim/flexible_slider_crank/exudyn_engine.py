@@ -21,9 +21,9 @@ import numpy as np
 
 from mechopt.errors import InputError
 from mechopt.sim.exudyn_sampling import add_driven_crank, sampled, solver_settings
-from mechopt.sim.flexible.kinematics import rigid_motion
-from mechopt.sim.flexible.parameters import FlexibleSliderCrank
-from mechopt.sim.flexible.response import Response
+from mechopt.sim.flexible_slider_crank.kinematics import rigid_motion
+from mechopt.sim.flexible_slider_crank.parameters import FlexibleSliderCrank
+from mechopt.sim.flexible_slider_crank.response import Response
 
 __all__ = ["simulate_exudyn"]
 

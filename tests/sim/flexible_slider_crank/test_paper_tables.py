@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from mechopt.sim.flexible import normalised_error
-from mechopt.sim.flexible.kinematics import rigid_motion
+from mechopt.sim.flexible_slider_crank import normalised_error
+from mechopt.sim.flexible_slider_crank.kinematics import rigid_motion
 
 OMEGA = 26.19
 T = np.linspace(0.0, 0.48, 121)  # 121 samples over two crank turns (0.48 s), as printed

@@ -23,8 +23,8 @@ import numpy as np
 
 from mechopt.errors import InputError
 from mechopt.optimize.problem import DesignProblem, Variable
-from mechopt.sim.flexible import ENGINES, MM, FlexibleSliderCrank, Response, normalised_error, simulate
-from mechopt.sim.flexible.response import normalised_residuals
+from mechopt.sim.flexible_slider_crank import ENGINES, MM, FlexibleSliderCrank, Response, normalised_error, simulate
+from mechopt.sim.flexible_slider_crank.response import normalised_residuals
 
 __all__ = ["DEFAULT_BOUNDS", "FlexibleSliderCrankProblem"]
 
@@ -176,7 +176,7 @@ class FlexibleSliderCrankProblem(DesignProblem):
 
     def figures(self, designs: Mapping[str, np.ndarray], out: Path) -> dict[str, Path]:
         """Response curves of each design against the target, and the first design's rod animated over a turn."""
-        from mechopt.sim.flexible.figures import animate_rod, plot_responses
+        from mechopt.sim.flexible_slider_crank.figures import animate_rod, plot_responses
 
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)

@@ -23,10 +23,10 @@ import numpy as np
 from numba import njit
 from scipy.linalg import eigh
 
-from mechopt.sim.flexible.beam import rod_matrices
-from mechopt.sim.flexible.kinematics import rigid_motion, rigid_state
-from mechopt.sim.flexible.parameters import FlexibleSliderCrank
-from mechopt.sim.flexible.response import Response
+from mechopt.sim.flexible_slider_crank.beam import rod_matrices
+from mechopt.sim.flexible_slider_crank.kinematics import rigid_motion, rigid_state
+from mechopt.sim.flexible_slider_crank.parameters import FlexibleSliderCrank
+from mechopt.sim.flexible_slider_crank.response import Response
 
 __all__ = ["natural_frequencies", "simulate_modal"]
 

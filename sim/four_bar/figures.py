@@ -11,9 +11,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from mechopt.sim.figure_file import figure_path, save_figure  # noqa: E402
-from mechopt.sim.fourbar.kinematics import joint_positions  # noqa: E402
-from mechopt.sim.fourbar.mechanism import FourBar  # noqa: E402
-from mechopt.sim.fourbar.result import SimulationResult  # noqa: E402
+from mechopt.sim.four_bar.kinematics import joint_positions  # noqa: E402
+from mechopt.sim.four_bar.mechanism import FourBar  # noqa: E402
+from mechopt.sim.four_bar.result import SimulationResult  # noqa: E402
 
 
 def draw_mechanism(ax, design: np.ndarray, mechanism: FourBar, psi: float, color: str, label: str | None = None,

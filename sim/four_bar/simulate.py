@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 
 from mechopt.errors import InputError
-from mechopt.sim.fourbar.analytic import simulate_analytic
-from mechopt.sim.fourbar.exudyn_engine import simulate_exudyn
-from mechopt.sim.fourbar.mechanism import FourBar
-from mechopt.sim.fourbar.pymunk_engine import simulate_pymunk
-from mechopt.sim.fourbar.result import SimulationResult
+from mechopt.sim.four_bar.analytic import simulate_analytic
+from mechopt.sim.four_bar.exudyn_engine import simulate_exudyn
+from mechopt.sim.four_bar.mechanism import FourBar
+from mechopt.sim.four_bar.pymunk_engine import simulate_pymunk
+from mechopt.sim.four_bar.result import SimulationResult
 
 ENGINES = ("pymunk", "analytic", "exudyn")
 

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from mechopt.sim.flexible.kinematics import rigid_motion
+from mechopt.sim.flexible_slider_crank.kinematics import rigid_motion
 
 
 def test_derivatives_match_finite_differences():

@@ -12,9 +12,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from mechopt.errors import InputError
-from mechopt.sim.fourbar.kinematics import BRANCH_SUBTRACT, validate_pivot
-from mechopt.sim.fourbar.load import RockerLoad
-from mechopt.sim.fourbar.motion import MotionLaw
+from mechopt.sim.four_bar.kinematics import BRANCH_SUBTRACT, validate_pivot
+from mechopt.sim.four_bar.load import RockerLoad
+from mechopt.sim.four_bar.motion import MotionLaw
 
 
 @dataclass(frozen=True)

@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 from mechopt.errors import InputError
-from mechopt.sim.flexible.parameters import FlexibleSliderCrank
-from mechopt.sim.flexible.response import Response
+from mechopt.sim.flexible_slider_crank.parameters import FlexibleSliderCrank
+from mechopt.sim.flexible_slider_crank.response import Response
 
 __all__ = ["ENGINES", "simulate"]
 
@@ -27,11 +27,11 @@ def simulate(p: FlexibleSliderCrank, engine: str = "modal") -> Response:
     Response
     """
     if engine == "modal":
-        from mechopt.sim.flexible.modal import simulate_modal
+        from mechopt.sim.flexible_slider_crank.modal import simulate_modal
 
         return simulate_modal(p)
     if engine == "exudyn":
-        from mechopt.sim.flexible.exudyn_engine import simulate_exudyn
+        from mechopt.sim.flexible_slider_crank.exudyn_engine import simulate_exudyn
 
         return simulate_exudyn(p)
     raise InputError(f"engine = {engine!r}; expected one of {', '.join(ENGINES)}")

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from mechopt.sim.flexible.problem import FlexibleSliderCrankProblem
+from mechopt.sim.flexible_slider_crank.problem import FlexibleSliderCrankProblem
 
 
 def test_residual_terms_sum_to_the_objective():

@@ -41,13 +41,13 @@ import numpy as np
 from numba import njit
 
 from mechopt.errors import InputError, MechoptError
-from mechopt.sim.fourbar.analytic import MM
-from mechopt.sim.fourbar.feasibility import require_movable
-from mechopt.sim.fourbar.kinematics import _crank_kernel, check_design, crank_angle
-from mechopt.sim.fourbar.load import _load_at
-from mechopt.sim.fourbar.mechanism import FourBar
-from mechopt.sim.fourbar.motion import _psi_at
-from mechopt.sim.fourbar.result import SimulationResult, rms_over_cycle
+from mechopt.sim.four_bar.analytic import MM
+from mechopt.sim.four_bar.feasibility import require_movable
+from mechopt.sim.four_bar.kinematics import _crank_kernel, check_design, crank_angle
+from mechopt.sim.four_bar.load import _load_at
+from mechopt.sim.four_bar.mechanism import FourBar
+from mechopt.sim.four_bar.motion import _psi_at
+from mechopt.sim.four_bar.result import SimulationResult, rms_over_cycle
 
 #: Default steps per cycle: a 2 ms step for the ventilator's 0.4 s cycle.
 N_STEPS = 200
