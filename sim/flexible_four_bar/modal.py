@@ -2,7 +2,8 @@
 
 Each flexible link (coupler B-C, follower O4-C) bends about its rigid chord, w(s, t), and obeys the paper's Eq. 9,
 M ẅ + C ẇ + K w = −M ü_r: the link's rigid-body transverse acceleration field a⊥0 + α s (:mod:`.loads`) loads a
-pinned-pinned Euler-Bernoulli beam (Hermite elements of :mod:`mechopt.sim.flexible_slider_crank.beam`).  As in the paper (Eq. 3)
+pinned-pinned Euler-Bernoulli beam (Hermite elements of :mod:`mechopt.sim.flexible_slider_crank.beam`).
+As in the paper (Eq. 3)
 the normal, Coriolis and tangential terms of the elastic motion are dropped (order ω3²/ω1² ≈ 1e-3).  The joints are
 pinned and the elastic displacement of C is neglected: it is axial strain, EI/(EA l²) ≈ 1e-5 of the bending.  So the
 two links bend independently; each keeps its lowest ``n_modes`` modes (Eqs. 13-16), material damping C = β K

@@ -82,8 +82,8 @@ def residuals(r: FourBarResponse, target: FourBarResponse) -> np.ndarray:
     """The residuals of Eq. 25, term after term in the order of :data:`TERMS`.
 
     A path contributes its x then its y residuals, (x_i − x*_i) / (R_x sqrt(N)) (2N values), D3 and D4 N values
-    each (:func:`~mechopt.sim.flexible_slider_crank.response.normalised_residuals`): the square root of a term's sum of squares
-    is that term of :func:`five_term_error`, so f = 0 exactly where every residual is 0.
+    each (:func:`~mechopt.sim.flexible_slider_crank.response.normalised_residuals`): the square root of a
+    term's sum of squares is that term of :func:`five_term_error`, so f = 0 exactly where every residual is 0.
 
     Returns
     -------
