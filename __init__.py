@@ -13,6 +13,8 @@ Public API (flat, as scipy.optimize and pymunk):
 - :class:`SampleStore` — the resumable SQLite store of simulated designs;
 - :class:`ObjectiveModel` — a fitted sparse model (``.predict``, ``.save``, ``.load``);
 - :func:`register_mechanism` — add a mechanism kind for study files;
+- :func:`tolerance`, :class:`Tolerances`, :func:`sensitivity` — a design's scatter under manufacturing tolerances
+  (probability of violating each margin, the objective's quantiles), Sobol indices of the objective;
 - errors: :class:`MechoptError` and its subclasses :class:`InputError`, :class:`StudyError`,
   :class:`InfeasibleDesignError`.
 
@@ -44,6 +46,9 @@ _LAZY = {
     "ObjectiveModel": "mechopt.optimize.sparse.model",
     "SampleStore": "mechopt.runs.store",
     "register_mechanism": "mechopt.studies.registry",
+    "tolerance": "mechopt.optimize.analysis.tolerance",
+    "sensitivity": "mechopt.optimize.analysis.sensitivity",
+    "Tolerances": "mechopt.optimize.analysis.scatter",
 }
 
 __all__ = [  # noqa: RUF022 - the eager names first, then the lazy ones
@@ -61,6 +66,9 @@ __all__ = [  # noqa: RUF022 - the eager names first, then the lazy ones
     "ObjectiveModel",
     "SampleStore",
     "register_mechanism",
+    "tolerance",
+    "sensitivity",
+    "Tolerances",
 ]
 
 

@@ -46,6 +46,8 @@ class Tolerances:
         Scattered designs per Monte Carlo estimate (a power of two: a scrambled Sobol set).
     seed : int
         Seed of the scrambling.
+    robust_simulations : int
+        Most simulations a robust optimum (:func:`mechopt.minimize` with ``tolerances=``) adds to the nominal run.
     """
 
     values: Mapping[str, float] = field(default_factory=dict)
@@ -53,6 +55,7 @@ class Tolerances:
     statistic: str | float = "mean"
     samples: int = 4096
     seed: int = 0
+    robust_simulations: int = 40
 
     def __post_init__(self) -> None:
         if not isinstance(self.values, Mapping):
@@ -69,6 +72,9 @@ class Tolerances:
         n = self.samples
         if isinstance(n, bool) or not isinstance(n, int) or n < 64 or n & (n - 1):
             raise InputError(f"samples = {n!r}: expected a power of two >= 64 (a scrambled Sobol set)")
+        r = self.robust_simulations
+        if isinstance(r, bool) or not isinstance(r, int) or r < 0:
+            raise InputError(f"robust_simulations = {r!r}: expected a whole number >= 0")
 
     def vector(self, problem: DesignProblem) -> np.ndarray:
         """The tolerances (d,) in the problem's variable order, checked against its variables.
