@@ -66,8 +66,8 @@ class RobustOptimum:
         """The robust and the nominal optimum side by side."""
         unit = problem.output_units.get(problem.objective, "")
         out = [f"robust optimum {problem.describe(self.x)}: {problem.objective} {self.fun:.6g} {unit} "
-               f"(+{100 * self.price:.2f} % over the nominal), P(any margin violated) {self.robust.violation['any']:.4f}"
-               f", scatter mean {self.robust.mean:.6g}",
+               f"(+{100 * self.price:.2f} % over the nominal), P(any margin violated) "
+               f"{self.robust.violation['any']:.4f}, scatter mean {self.robust.mean:.6g}",
                f"nominal optimum {problem.describe(self.nominal_x)}: {problem.objective} {self.nominal_fun:.6g} "
                f"{unit}, P(any margin violated) {self.nominal.violation['any']:.4f}, scatter mean "
                f"{self.nominal.mean:.6g}",
@@ -77,7 +77,8 @@ class RobustOptimum:
     def to_dict(self, problem: DesignProblem) -> dict[str, Any]:
         """JSON-able summary."""
         def stats(s: ScatterStatistics) -> dict[str, Any]:
-            return {"violation": s.violation, "mean": s.mean, "quantiles": {f"{k:g}": v for k, v in s.quantiles.items()}}
+            return {"violation": s.violation, "mean": s.mean,
+                    "quantiles": {f"{k:g}": v for k, v in s.quantiles.items()}}
 
         return {"x": dict(zip(problem.names, map(float, self.x), strict=True)), "fun": self.fun,
                 "nominal_x": dict(zip(problem.names, map(float, self.nominal_x), strict=True)),

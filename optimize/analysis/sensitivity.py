@@ -55,8 +55,9 @@ class Sensitivity:
 
     def lines(self) -> list[str]:
         """The indices, one variable a line."""
-        out = [f"Sobol indices over {', '.join(f'{n} [{lo:g}, {hi:g}]' for n, (lo, hi) in zip(self.names, self.region, strict=True))}"
-               f" ({100 * self.infeasible_share:.0f} % of it infeasible; model of {self.model_designs} designs)"]
+        box = ", ".join(f"{n} [{lo:g}, {hi:g}]" for n, (lo, hi) in zip(self.names, self.region, strict=True))
+        out = [f"Sobol indices over {box} ({100 * self.infeasible_share:.0f} % of it infeasible; "
+               f"model of {self.model_designs} designs)"]
         out += [f"  {n:>8s}: first order {f:.3f}, total {t:.3f}"
                 for n, f, t in zip(self.names, self.first_order, self.total_order, strict=True)]
         return out
