@@ -19,6 +19,7 @@ from mechopt.cli import (
     region_commands,
     simulate_command,
     study_command,
+    tolerance_command,
     validate_command,
 )
 from mechopt.cli.arguments import Parser
@@ -63,6 +64,7 @@ def build_parser() -> argparse.ArgumentParser:
     validate_command.add_parser(sub, ENGINES)
     region_commands.add_parsers(sub, ENGINES)
     compare_command.add_parser(sub, ENGINES)
+    tolerance_command.add_parser(sub, ENGINES)
     return parser
 
 
