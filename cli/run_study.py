@@ -21,6 +21,7 @@ from mechopt.cli.study_header import study_header
 from mechopt.cli.study_options import study_options
 from mechopt.cli.study_plan import RunPlan, duration_text, open_store_if_any, plan_run, plan_validation
 from mechopt.errors import InputError, MechoptError
+from mechopt.optimize.analysis.robust_result import make_study_robust
 from mechopt.optimize.arguments import check_method
 from mechopt.optimize.ground_truth import GroundTruth, load_or_compute
 from mechopt.optimize.minimize import checked_options, parallel_accounting, run_method
@@ -132,6 +133,7 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
         t0 = time.perf_counter()
         share = options if x0 is None else checked_options(problem, method, options, options.budget, options.seed, x0)
         result = run_method(problem, method, share, sampler, log, x0=x0)
+        make_study_robust(study, result, sampler, log)
         timings["optimise_s"] = time.perf_counter() - t0
         n_opt = len(sampler.designs)
         timing = sampler.timing()

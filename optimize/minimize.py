@@ -13,6 +13,8 @@ from typing import Any
 import numpy as np
 
 from mechopt.errors import InfeasibleDesignError, InputError, MechoptError
+from mechopt.optimize.analysis.robust_result import checked_robust, make_robust
+from mechopt.optimize.analysis.scatter import Tolerances
 from mechopt.optimize.arguments import (
     AUTO_METHOD,
     DEFAULT_METHOD,
@@ -66,9 +68,8 @@ def _check_arguments(problem: Any, budget: Any, method: Any, seed: Any, workers:
 def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[..., Any] = DEFAULT_METHOD,
              seed: int = 0, workers: int | None = 1, store: str | Path | SampleStore | None = None,
              options: Mapping[str, Any] | SparseOptions | None = None, scheduler: Any = None,
-             progress: bool = False, retry_failed: bool = False,
-             log: Callable[[str], None] | None = None, x0: Any = None, tolerances: Any = None,
-             max_violation: float = 0.01) -> OptimizeResult:
+             progress: bool = False, retry_failed: bool = False, tolerances: Any = None,
+             log: Callable[[str], None] | None = None, x0: Any = None, max_violation: float = 0.01) -> OptimizeResult:
     """Minimise a design problem's objective within a budget of simulations.
 
     Parameters
@@ -113,14 +114,8 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
         Designs to simulate first, in the variables' units: the current design, earlier candidates.  They count in
         the budget, the result is never worse than the best of them, and ``"auto"`` fits its model to them in place
         of as many of its space-filling designs.  Inside the bounds and satisfying the declared constraints.
-    tolerances : mapping, float or Tolerances, optional
-        ± manufacturing tolerance per variable in its unit (``{"oa": 0.1}``; :class:`mechopt.Tolerances` for the
-        distribution and the statistic): the answer ``x`` is then the robust optimum, minimising the objective's mean
-        (or chosen quantile) over the scatter with each margin violated with probability <= ``max_violation``;
-        ``nominal_x``, ``nominal_fun`` and ``robust`` (:mod:`mechopt.optimize.analysis.robust`) hold the rest.  Its
-        simulations (``Tolerances.robust_simulations``) come on top of ``budget``.
-    max_violation : float
-        Target probability of violating each margin, in (0, 0.5).
+    tolerances, max_violation : mapping or Tolerances, and float in (0, 0.5), optional
+        ``x`` becomes the robust optimum under ± tolerances (``{"oa": 0.1}``): :mod:`mechopt.optimize.analysis.robust`.
 
     Returns
     -------
@@ -135,14 +130,8 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
     InputError
         A bad argument, before any simulation.
     """
-    _check_arguments(problem, budget, method, seed, workers, store)
-    X0 = check_x0(problem, x0, int(budget))
-    opts = checked_options(problem, method, options, int(budget), int(seed), X0)
-    from mechopt.optimize.analysis.robust_result import checked_robust, make_robust
-
-    tols = checked_robust(problem, tolerances, max_violation)
-    log = log or (lambda _line: None)
-    t0 = time.perf_counter()
+    X0, opts, tols = _checked(problem, budget, method, seed, workers, store, x0, options, tolerances, max_violation)
+    t0, log = time.perf_counter(), log or (lambda _line: None)
     with contextlib.ExitStack() as stack:
         db = _open_store(store, stack)
         executor = stack.enter_context(make_executor(workers=workers, scheduler=scheduler))
@@ -153,10 +142,18 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
                                             opts.validation_points, opts.seed, f_min=result.fun)
             result["trust"] = study_trust(result.stages[0], result.pipeline.best, result.validation)
         _account(result, sampler)
-        if tols is not None:
-            make_robust(problem, result, sampler, tols, max_violation, log)
+        make_robust(problem, result, sampler, tols, max_violation, log)
     result["wall_time_s"] = time.perf_counter() - t0
     return result
+
+
+def _checked(problem: DesignProblem, budget: int, method: Any, seed: int, workers: Any, store: Any, x0: Any,
+             options: Any, tolerances: Any, max_violation: Any) -> tuple[Any, SparseOptions, Tolerances | None]:
+    """Every argument of :func:`minimize` checked before any simulation: x0, the options, the tolerances."""
+    _check_arguments(problem, budget, method, seed, workers, store)
+    X0 = check_x0(problem, x0, int(budget))
+    return X0, checked_options(problem, method, options, int(budget), int(seed), X0), checked_robust(
+        problem, tolerances, max_violation)
 
 
 def _account(result: OptimizeResult, sampler: Sampler) -> None:

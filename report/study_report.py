@@ -12,6 +12,7 @@ import numpy as np
 from mechopt.errors import InputError
 from mechopt.report.convergence import plot_convergence
 from mechopt.report.plots import plot_feasible_3d, plot_feasible_slices, plot_validation
+from mechopt.report.tolerance_section import tolerance_lines, tolerance_summary
 
 __all__ = ["write_outputs"]
 
@@ -127,6 +128,7 @@ def result_dict(run) -> dict[str, Any]:
         "plan": None if getattr(run, "plan", None) is None else run.plan.to_dict(),
         "store": str(run.store_path),
         "timings_s": run.timings,
+        "tolerances": tolerance_summary(problem, res, study),
     }
 
 
@@ -220,6 +222,7 @@ def report_markdown(r: dict[str, Any], study) -> str:
              _simulations_sentence(r), "",
              "## Designs", ""]
     lines += _design_table(r, problem, names, units)
+    lines += tolerance_lines(r)
     if r["failures"]:
         lines += ["", f"## Failed simulations ({len(r['failures'])})", "", "| design | error |", "|---|---|"]
         lines += [f"| {problem.describe(np.array([f['design'][n] for n in names]))} | {f['error']} |"

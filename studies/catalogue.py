@@ -32,7 +32,7 @@ OVERRIDES = ("engine",)
 #: Top-level keys the engine reads (a plug-in reads its own sections through :meth:`StudyFile.table`, which
 #: records them); any other key of a study file is refused.
 ENGINE_SECTIONS = {"name", "description", "kind", "method", "variables", "designs", "surrogate", "paper", "compare",
-                   "validation", "simulator"}
+                   "validation", "simulator", "tolerances"}
 
 
 @dataclass(frozen=True)
@@ -60,6 +60,8 @@ class Study:
     method : str
         The study's own choice of method (its key ``method``; ``--method`` overrides it); empty: the default of
         :func:`mechopt.minimize`.
+    tolerances : StudyTolerances or None
+        Its ``[tolerances]`` table (:mod:`mechopt.studies.tolerances_section`).
     """
 
     name: str
@@ -71,6 +73,7 @@ class Study:
     paper: dict[str, Any] = field(default_factory=dict)
     file: StudyFile | None = None
     method: str = ""
+    tolerances: Any = None
 
     def design(self, name: str) -> np.ndarray:
         """Reference design ``name`` as an array in the problem's variable order."""
@@ -205,6 +208,9 @@ def _load_cached(path_str: str, _mtime: int, options: tuple) -> Study:
         raise StudyError(f"{path.name}: {exc}") from None
     designs = _designs(file, problem)
     paper = file.table("paper", required=False)
+    from mechopt.studies.tolerances_section import read_tolerances
+
+    tolerances = read_tolerances(file, problem)
     unread = sorted(set(config) - ENGINE_SECTIONS - file.read)
     if unread:
         raise StudyError(f"{path.name}: unknown key {unread[0]}; kind {kind!r} reads "
@@ -213,7 +219,8 @@ def _load_cached(path_str: str, _mtime: int, options: tuple) -> Study:
     if not isinstance(method, str):
         raise StudyError(f"{path.name}: key method must be a method's name (`mechopt methods`), got {method!r}")
     return Study(name=name, path=path, description=str(config.get("description", "")), kind=kind, problem=problem,
-                 designs=designs, paper=dict(paper), file=file, method=method)
+                 designs=designs, paper=dict(paper), file=file, method=method,
+                 tolerances=tolerances)
 
 
 def _designs(file: StudyFile, problem: DesignProblem) -> dict[str, dict[str, float]]:

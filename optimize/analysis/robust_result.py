@@ -12,7 +12,7 @@ from mechopt.optimize.analysis.robust import robust_optimum
 from mechopt.optimize.analysis.scatter import Tolerances, as_tolerances, check_max_violation
 from mechopt.optimize.problem import DesignProblem
 
-__all__ = ["checked_robust", "make_robust"]
+__all__ = ["checked_robust", "make_robust", "make_study_robust"]
 
 
 def checked_robust(problem: DesignProblem, tolerances: Any, max_violation: Any) -> Tolerances | None:
@@ -24,11 +24,12 @@ def checked_robust(problem: DesignProblem, tolerances: Any, max_violation: Any) 
     return tol
 
 
-def make_robust(problem: DesignProblem, result: Any, sampler: Any, tolerances: Tolerances, max_violation: float,
-                log: Callable[[str], None]) -> None:
+def make_robust(problem: DesignProblem, result: Any, sampler: Any, tolerances: Tolerances | None,
+                max_violation: float, log: Callable[[str], None]) -> None:
     """Replace ``result.x`` and ``result.fun`` by the robust optimum; the nominal one goes to ``nominal_x`` and
-    ``nominal_fun``, the comparison to ``robust`` (:class:`~mechopt.optimize.analysis.robust.RobustOptimum`)."""
-    if not result.success:
+    ``nominal_fun``, the comparison to ``robust`` (:class:`~mechopt.optimize.analysis.robust.RobustOptimum`).
+    Nothing without tolerances, or when the run found no design."""
+    if tolerances is None or not result.success:
         return
     log(f"robust optimum: {tolerances.describe(problem)}, each margin violated with probability <= {max_violation}")
     robust = robust_optimum(problem, sampler, np.asarray(result.x, dtype=float), tolerances, max_violation,
@@ -38,3 +39,10 @@ def make_robust(problem: DesignProblem, result: Any, sampler: Any, tolerances: T
     result.update(nominal_x=robust.nominal_x, nominal_fun=robust.nominal_fun, robust=robust, x=robust.x,
                   fun=robust.fun)
     result["outputs"] = dict(sampler.records(robust.x[None, :], desc="robust optimum")[0].outputs)
+
+
+def make_study_robust(study: Any, result: Any, sampler: Any, log: Callable[[str], None]) -> None:
+    """:func:`make_robust` with a study's ``[tolerances]``, when it sets ``max_violation``."""
+    declared = getattr(study, "tolerances", None)
+    if declared is not None and declared.max_violation is not None:
+        make_robust(study.problem, result, sampler, declared.tolerances, declared.max_violation, log)
