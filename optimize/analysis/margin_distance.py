@@ -14,7 +14,7 @@ from mechopt.optimize.problem import DesignProblem
 __all__ = ["ACTIVE", "default_tolerances", "margin_distances"]
 
 #: A margin is active when moving the design by this fraction of each variable's range along the margin's gradient
-#: would make it fail.
+#: would make it fail, or when the tolerances make it fail on some parts.
 ACTIVE = 0.01
 #: Tolerance assumed when a study declares none: 0.1 of the unit for lengths in mm (a drawing's default), else this
 #: fraction of the variable's range.
@@ -72,7 +72,7 @@ def margin_distances(problem: DesignProblem, x: Any, tolerances: Tolerances | No
     for j, c in enumerate(problem.constraints):
         g = G[j]
         scaled = float(np.linalg.norm(g * w))
-        if not np.isfinite(m[j]) or scaled == 0.0 or m[j] / scaled > ACTIVE:
+        if not np.isfinite(m[j]) or scaled == 0.0 or (m[j] / scaled > ACTIVE and p[c] == 0.0):
             continue
         along = {v.name: float(-m[j] / gi) for v, gi in zip(problem.variables, g, strict=True) if gi != 0.0}
         nearest = float(m[j] / np.linalg.norm(g))
