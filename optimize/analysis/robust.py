@@ -27,6 +27,9 @@ __all__ = ["RobustOptimum", "robust_optimum", "safe_level"]
 
 #: Margins of designs that cannot be assembled are -inf; the quantile needs finite values.
 _FLOOR = -1e6
+#: The search stops when a round moves the design by less than this many tolerances in every variable: the
+#: scatter's statistics then change by a small part of their spread.
+CONVERGED = 0.25
 
 
 @dataclass(frozen=True)
@@ -159,7 +162,7 @@ def robust_optimum(problem: DesignProblem, sampler: Any, nominal_x: np.ndarray, 
         new = _solve(problem, model.predict, D, x, level, tolerances.statistic)
         moved = np.abs(new - x) / t.clip(min=1e-12)
         log(f"  robust round {rnd + 1}: {problem.describe(new)} (moved {moved.max():.3g} tolerances)")
-        if rnd and moved.max() < 0.05:
+        if rnd and moved.max() < CONVERGED:
             message = f"converged after {rnd + 1} rounds (the last moved {moved.max():.2g} tolerances)"
             x = new
             break
