@@ -27,7 +27,10 @@ def tolerance_lines(r: dict[str, Any]) -> list[str]:
     t = r.get("tolerances")
     if not t or (not t["margins"]["lines"] and t["robust"] is None):
         return []
-    lines = ["", "## Margins and tolerances", "", *t["margins"]["lines"]]
+    margins = t["margins"]["lines"]
+    if t["robust"] is not None:  # the distances are those of the nominal optimum, which the robust one moved from
+        margins = [line.replace("of the optimum", "of the nominal optimum") for line in margins]
+    lines = ["", "## Margins and tolerances", "", *margins]
     if not t["declared"]:
         lines += ["", "(The study declares no `[tolerances]`: a drawing's default is assumed.)"]
     if t["robust"] is not None:
