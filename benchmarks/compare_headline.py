@@ -12,7 +12,7 @@ import argparse
 import json
 from pathlib import Path
 
-from mechopt.cli.compare import headline, plot_headline
+from mechopt.studies.comparison import headline, plot_headline
 
 
 def main() -> None:

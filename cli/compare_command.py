@@ -49,9 +49,9 @@ def _studies(args: argparse.Namespace, names: list[str]) -> list:
 
 def run(args: argparse.Namespace, rest: list[str]) -> int:
     """Run every method at every budget and seed on every study; write the tables and figures."""
-    from mechopt.cli import compare as cmp
-    from mechopt.cli.run_study import check_output_folder
     from mechopt.optimize.ground_truth import load_or_compute
+    from mechopt.studies import comparison as cmp
+    from mechopt.studies.runner import check_output_folder
 
     names = [n for n in study_name(args).split(",") if n]
     methods = cmp.method_names(args.methods)

@@ -43,9 +43,9 @@ def _saved_model(model_path: Path, study, refit: bool):
 
 def run(args: argparse.Namespace, rest: list[str]) -> int:
     """Validate the saved (or a refitted) model on held-out lines; print the errors, write the figure."""
-    from mechopt.cli.run_study import check_output_folder, plan_validate, study_options
     from mechopt.optimize.arguments import check_budget
     from mechopt.report.plots import plot_validation
+    from mechopt.studies.runner import check_output_folder, plan_validate, study_options
 
     study = load(args)
     if args.budget is not None:
@@ -79,13 +79,13 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
 def _simulate(args: argparse.Namespace, study, options, out: Path, store_path: Path, model, f_min: float):
     """Fit the line model if there is none (saved beside the run), then simulate the held-out lines; the validation,
     the model, the lines it was fitted on (None: read) and a line saying what was simulated and what reused."""
-    from mechopt.cli.study_plan import plan_validation
     from mechopt.optimize.sparse.sampler import Sampler
     from mechopt.optimize.sparse.space import ModelSpace
     from mechopt.optimize.sparse.stage import build_stage
     from mechopt.optimize.sparse.validate import validate
     from mechopt.runs.executors import make_executor
     from mechopt.runs.store import SampleStore
+    from mechopt.studies.plan import plan_validation
 
     space = ModelSpace(study.problem)
     fit_lines = None

@@ -92,14 +92,12 @@ def quiet_peer(problem, seed: int):
 
 @pytest.fixture
 def test_only_peers(monkeypatch):
-    from mechopt.cli import compare as cmp
-    from mechopt.optimize.baselines import BASELINES
+    from mechopt.optimize.methods import METHODS, Method
 
-    # Registered where `mechopt compare` and `mechopt.minimize` resolve method names; quiet_peer counts as a
-    # library peer, one that must spend its whole budget.
-    monkeypatch.setitem(BASELINES, "flaky_peer", flaky_peer)
-    monkeypatch.setitem(BASELINES, "quiet_peer", quiet_peer)
-    monkeypatch.setattr(cmp, "SPENDS_WHOLE_BUDGET", cmp.SPENDS_WHOLE_BUDGET | {"quiet_peer"})
+    # Two records in the table of methods, which `mechopt compare` and `mechopt.minimize` read; quiet_peer counts as
+    # a library peer, one that must spend its whole budget.
+    monkeypatch.setitem(METHODS, "flaky_peer", Method("flaky_peer", flaky_peer, "test only"))
+    monkeypatch.setitem(METHODS, "quiet_peer", Method("quiet_peer", quiet_peer, "test only", spends_whole_budget=True))
 
 
 def test_a_peer_failing_part_way_is_marked_and_not_counted(tmp_path, capsys, test_only_peers):
@@ -143,7 +141,7 @@ def test_a_peer_failing_part_way_is_marked_and_not_counted(tmp_path, capsys, tes
 
 
 def test_the_headline_marks_methods_with_unfinished_runs():
-    from mechopt.cli.compare import headline, unfinished_methods
+    from mechopt.studies.comparison import headline, unfinished_methods
 
     rows = [{"method": "peer", "budget": 30, "median_reached": True, "complete": False},
             {"method": "ours", "budget": 30, "median_reached": True, "complete": True}]
@@ -154,7 +152,8 @@ def test_the_headline_marks_methods_with_unfinished_runs():
 
 
 def test_smt_ego_beyond_its_limit_is_refused_in_one_line(tmp_path, capsys):
-    from mechopt.cli.compare import check_methods, ego_max_budget
+    from mechopt.optimize.baselines.smt_ego import max_budget as ego_max_budget
+    from mechopt.studies.comparison import check_methods
 
     limit = ego_max_budget(2)  # Branin's 2 variables
     code = main(["compare", "--study", "branin", "--out", str(tmp_path), "--seeds", "1", "--budgets",
@@ -172,7 +171,7 @@ def test_smt_ego_beyond_its_limit_is_refused_in_one_line(tmp_path, capsys):
 
 
 def test_a_line_model_named_for_a_study_it_cannot_take_is_refused():
-    from mechopt.cli.compare import check_methods
+    from mechopt.studies.comparison import check_methods
 
     with pytest.raises(InputError, match="--methods mechopt-global: method 'sparse-global' handles 2 to 4"):
         check_methods(["mechopt-global"], [60], dims=[6])
@@ -182,8 +181,8 @@ def test_a_line_model_named_for_a_study_it_cannot_take_is_refused():
 def test_a_run_refused_for_its_budget_is_marked_with_the_reason():
     # Hartmann-4's line plan needs 11 simulations: at 10 the run is refused, and the table says so (it showed an
     # unexplained infinite gap); at 11 it runs.
-    from mechopt.cli.compare import known_truth, run_one
     from mechopt.studies.catalogue import load_study
+    from mechopt.studies.comparison import known_truth, run_one
 
     problem = load_study("hartmann4").problem
     truth = known_truth(problem)
@@ -196,7 +195,7 @@ def test_a_run_refused_for_its_budget_is_marked_with_the_reason():
 
 def test_methods_by_the_names_study_and_minimize_give_them():
     # `mechopt study --method auto` and then `mechopt compare --methods auto` was "unknown method 'auto'".
-    from mechopt.cli.compare import check_methods, method_names
+    from mechopt.studies.comparison import check_methods, method_names
 
     assert method_names("auto,sparse,sparse-global,smt_ego") == ["mechopt-auto", "mechopt-sparse", "mechopt-global",
                                                                  "smt_ego"]

@@ -17,9 +17,6 @@ from typing import Any
 
 import numpy as np
 
-from mechopt.cli.study_header import study_header
-from mechopt.cli.study_options import study_options
-from mechopt.cli.study_plan import RunPlan, duration_text, open_store_if_any, plan_run, plan_validation
 from mechopt.errors import InputError, MechoptError
 from mechopt.optimize.arguments import check_method
 from mechopt.optimize.ground_truth import GroundTruth, load_or_compute
@@ -33,6 +30,9 @@ from mechopt.optimize.sparse.validate import Validation, validate
 from mechopt.runs.executors import check_reachable, default_workers, make_executor
 from mechopt.runs.store import SampleStore
 from mechopt.studies.catalogue import Study
+from mechopt.studies.plan import RunPlan, duration_text, open_store_if_any, plan_run, plan_validation
+from mechopt.studies.run_header import study_header
+from mechopt.studies.run_options import study_options
 
 __all__ = ["StudyRun", "check_output_folder", "check_run", "plan_study", "rounds_text", "run_study",
            "study_options", "summary_lines"]
