@@ -257,7 +257,7 @@ def check_options(method: str | Callable[..., OptimizeResult], options: Mapping[
     if unknown:
         takes = f"expected one of {', '.join(declared)}" if declared else "it takes none"
         raise InputError(f"unknown option {unknown[0]!r} of method {record.name!r}; {takes} "
-                         f"(`mechopt methods --options {record.name}`)")
+                         f"(`mechopt methods {record.name}`)")
     return {name: declared[name].check(value, f"method {record.name!r}: ") for name, value in given.items()}
 
 
@@ -278,16 +278,16 @@ def show_options(method: str | None = None) -> str:
     Returns
     -------
     str
-        Per method: its name and summary, its dimensions, least budget, batches and objectives, then one line per
-        option with its type and default.
+        Per method: a line with its name and summary, then indented its dimensions, least budget, batches and
+        objectives, and one line per option with its type, default and description.
     """
     records = [get_method(method)] if method is not None else list(METHODS.values())
     blocks = []
     for m in records:
         need = m.min_budget(3, 600, None)[1]
-        head = (f"{m.name}: {m.summary}\n  takes {m.dims_text()} variables, budget >= {need}, "
+        head = (f"{m.name}  {m.summary}\n  takes {m.dims_text()} variables, budget >= {need}, "
                 f"{'batches of designs' if m.batches else 'one design at a time'}, {m.max_objectives} "
                 f"objective{'s' if m.max_objectives > 1 else ''}{', discrete variables' if m.discrete else ''}")
         lines = [_option_line(o) for o in m.declared]
         blocks.append("\n".join([head, "  options:" if lines else "  options: none", *lines]))
-    return "\n\n".join(blocks)
+    return "\n".join(blocks)
