@@ -76,9 +76,7 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
         budgets[study.name] = cmp.largest_budgets(rows)
         unfinished[study.name] = cmp.unfinished_methods(rows)
     if len(studies) > 1:
-        text = cmp.headline(needed, budgets, unfinished)
-        (base / "headline.md").write_text(text)
-        fig = cmp.plot_headline(needed, budgets, base / "figures" / "compare_headline.png", unfinished)
+        text, md, fig = cmp.write_headline(needed, budgets, base, unfinished)
         print(text)
-        print(f"headline written to {base / 'headline.md'}, figure to {fig}")
+        print(f"headline written to {md}, figure to {fig}")
     return 0

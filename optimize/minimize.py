@@ -76,9 +76,8 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
         SQLite sample store: designs found there (same problem fingerprint) are not simulated again, and every new
         one is committed as soon as it is known.  Default: a temporary store, discarded at the end.
     options : mapping or SparseOptions, optional
-        The method's options (:func:`mechopt.optimize.methods.show_options`, ``mechopt methods --options``); an
-        unknown one is refused.  The sparse method's (``SparseOptions.help()``) are scaled to the budget, and
-        ``validation_lines`` defaults to 0 here (no held-out lines).
+        The method's options (``mechopt methods NAME``); an unknown one is refused.  The sparse method's are scaled
+        to the budget, and its ``validation_lines`` defaults to 0 here (no held-out lines).
     scheduler : str, optional
         A Dask scheduler address (or a client, or a ``LocalCluster``) to evaluate on instead of local processes;
         ``workers`` is then how many designs run at once there: ``workers=None`` for every worker thread of the
@@ -109,10 +108,7 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
     """
     _check_arguments(problem, budget, method, seed, workers, store)
     X0 = check_x0(problem, x0, int(budget))
-    # The line model's options are its SparseOptions; any other method's are checked against its record.
-    whole = get_method(method).line_model or isinstance(options, SparseOptions)
-    own = {} if whole else check_options(method, options)
-    opts = checked_options(problem, method, options if whole else None, int(budget), int(seed), X0)
+    opts, own = _split_options(problem, method, options, int(budget), int(seed), X0)
     log = log or (lambda _line: None)
     t0 = time.perf_counter()
     with contextlib.ExitStack() as stack:
@@ -127,6 +123,16 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
         _account(result, sampler)
     result["wall_time_s"] = time.perf_counter() - t0
     return result
+
+
+def _split_options(problem: DesignProblem, method: str | Callable[..., Any],
+                   options: Mapping[str, Any] | SparseOptions | None, budget: int, seed: int,
+                   x0: np.ndarray | None) -> tuple[SparseOptions, dict[str, Any]]:
+    """The run's SparseOptions (budget, seed, and the line model's settings) and the method's own checked options:
+    a line model's options are its SparseOptions, any other method's are checked against its record."""
+    whole = get_method(method).line_model or isinstance(options, SparseOptions)
+    own = {} if whole else check_options(method, options)
+    return checked_options(problem, method, options if whole else None, budget, seed, x0), own
 
 
 def _account(result: OptimizeResult, sampler: Sampler) -> None:

@@ -26,9 +26,11 @@ from mechopt.studies.comparison.tables import (
     unfinished_methods,
     unfinished_runs,
     write,
+    write_headline,
 )
 
 __all__ = ["OWN_METHOD", "UNFINISHED_MARK", "Run", "check_limits", "check_methods", "compare", "compared_methods",
            "declared_truth", "gap_measure", "gap_pct", "headline", "known_truth", "largest_budgets", "markdown",
            "method_caps", "method_names", "pivot_markdown", "run_one", "simulations_needed", "table",
-           "tolerance", "true_objective", "unfinished_methods", "unfinished_runs", "write"]
+           "tolerance", "true_objective", "unfinished_methods", "unfinished_runs", "write",
+           "write_headline"]

@@ -15,7 +15,7 @@ from mechopt.optimize.ground_truth import GroundTruth
 from mechopt.optimize.problem import DesignProblem
 from mechopt.studies.catalogue import Study
 
-__all__ = ["declared_truth", "gap_measure", "gap_pct", "known_truth", "tolerance"]
+__all__ = ["declared_truth", "gap_basis", "gap_measure", "gap_pct", "known_truth", "tolerance"]
 
 
 def known_truth(problem: DesignProblem) -> GroundTruth | None:
@@ -77,3 +77,11 @@ def gap_measure(problem: DesignProblem, truth: GroundTruth) -> str:
     if truth.fun:
         return f"% of {obj}*: 100 ({obj} / {obj}* - 1)"
     return f"100 ({obj} - {obj}*), {obj}* = 0"
+
+
+def gap_basis(problem: DesignProblem, truth: GroundTruth) -> str:
+    """The gap's unit in a few words, for a column header (:func:`gap_measure` says it in full)."""
+    obj = problem.objective
+    if _f_range(problem) is not None:
+        return f"% of the range of {obj}"
+    return f"% of {obj}*" if truth.fun else f"100 {obj}, {obj}* = 0"

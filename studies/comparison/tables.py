@@ -18,10 +18,10 @@ from mechopt.optimize.ground_truth import GroundTruth
 from mechopt.optimize.problem import DesignProblem
 from mechopt.studies.catalogue import Study
 from mechopt.studies.comparison.engine import Run
-from mechopt.studies.comparison.score import gap_measure, gap_pct, tolerance
+from mechopt.studies.comparison.score import gap_basis, gap_measure, gap_pct, tolerance
 
 __all__ = ["UNFINISHED_MARK", "headline", "largest_budgets", "markdown", "pivot_markdown", "simulations_needed",
-           "cell_text", "table", "unfinished_methods", "unfinished_runs", "write"]
+           "cell_text", "table", "unfinished_methods", "unfinished_runs", "write", "write_headline"]
 
 #: The mark of an unfinished run in the tables.
 UNFINISHED_MARK = "†"
@@ -99,7 +99,8 @@ def markdown(rows: list[dict], truth: GroundTruth, study: Study, seeds: int, run
     lines = [f"Optimum {obj}* = {truth.fun:.6g} at {problem.describe(np.array(truth.x))} ({_source(truth)}). "
              f"Simulator: {engine}; {seeds} seeds per method and budget; every returned design scored by its true "
              f"{obj}. Gap: {measure}.", "",
-             f"| method | budget | runs | median {obj} | best {obj} | worst {obj} | {obj}* | median gap ({measure}) "
+             f"| method | budget | runs | median {obj} | best {obj} | worst {obj} | {obj}* | median gap "
+             f"({gap_basis(problem, truth)}) "
              f"| gap within 1 % | calls (median / max) | wall (s) | stopped early {UNFINISHED_MARK} |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
@@ -233,3 +234,22 @@ def write(runs: list[Run], truth: GroundTruth, out: Path, study: Study, seeds: i
     threshold = gap_pct(study.problem, truth, truth.fun + tolerance(study.problem, truth))
     fig = plot_gaps(rows, out / "figures" / "compare_gaps.png", threshold, gap_measure(study.problem, truth))
     return md, fig
+
+
+def write_headline(needed: dict[str, dict[str, int | None]], budgets: dict[str, Any], out: Path,
+                   unfinished: dict[str, set[str]] | None = None) -> tuple[str, Path, Path]:
+    """Write headline.md and figures/compare_headline.png of a comparison on several studies into ``out``.
+
+    Returns
+    -------
+    text : str
+        The table (:func:`headline`).
+    md, fig : Path
+        The files written.
+    """
+    from mechopt.report.comparison_figures import plot_headline
+
+    text = headline(needed, budgets, unfinished)
+    md = out / "headline.md"
+    md.write_text(text)
+    return text, md, plot_headline(needed, budgets, out / "figures" / "compare_headline.png", unfinished)

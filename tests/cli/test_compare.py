@@ -134,10 +134,33 @@ def test_a_peer_failing_part_way_is_marked_and_not_counted(tmp_path, capsys, tes
 
     md = (tmp_path / "compare.md").read_text()
     assert "| flaky_peer | 20 | 2 |" in md and "| 1 † |" in md and "| 2 † |" in md
-    assert "| quiet_peer | 20 | 2 | — | — | — | — | — |" in md  # nothing finished: nothing scored
+    assert "| quiet_peer | 20 | 2 | — | — | — | 0.397887 | — | — |" in md  # nothing finished: only f* to show
     assert "3 run(s) stopped before spending their budget and are not counted" in md
     assert "- flaky_peer at budget 20, seed 0: 4 of 20 simulations, stopped before its budget (raised" in md
-    assert "| flaky_peer | " in md.split("Median gap")[1] and "% † |" in md.split("Median gap")[1]
+    assert "| flaky_peer | " in md.split("Median gap")[1] and ") † |" in md.split("Median gap")[1]
+
+
+def test_every_compare_table_states_its_measure_and_shows_f_and_f_star(tmp_path):
+    # DE on Branin at 20 simulations: a gap of a fraction of a per cent of the range (308) can be f three times f*;
+    # the tables say what the gap is a percentage of and show f and f* beside it.
+    from mechopt.studies import comparison as cmp
+    from mechopt.studies.catalogue import load_study
+
+    study = load_study("branin", {})
+    truth = cmp.known_truth(study.problem)
+    runs = cmp.compare(study, truth, [20], 1, ["differential_evolution"], progress=lambda _line: None)
+    md_path, _ = cmp.write(runs, truth, tmp_path, study, 1)
+    md = md_path.read_text()
+    value = runs[0].value
+    assert value > truth.fun
+    assert runs[0].gap_pct == pytest.approx(100 * (value - truth.fun) / study.problem.f_range)
+    assert "Gap: % of the range of f over the box (307.7): 100 (f - f*) / range." in md
+    header = next(line for line in md.splitlines() if line.startswith("| method | budget"))
+    assert "| median f | best f | worst f | f* | median gap (% of the range of f) |" in header
+    row = next(line for line in md.splitlines() if line.startswith("| differential_evolution | 20 |"))
+    assert f"| {value:.6g} | {value:.6g} | {value:.6g} | {truth.fun:.6g} | {runs[0].gap_pct:+.2f} % |" in row
+    pivot = md.split("Median gap to the optimum f* = 0.397887 (% of the range of f over the box")[1]
+    assert f"| differential_evolution | {runs[0].gap_pct:+.2f} % (f {value:.4g}) |" in pivot
 
 
 def test_the_headline_marks_methods_with_unfinished_runs():
