@@ -138,10 +138,8 @@ def _at_most(limit: int) -> Callable[[int], int]:
 BAYESIAN_MAX_BUDGET = 200
 
 
-def _records() -> list[Method]:
-    """Every method, in the order ``mechopt methods`` lists them: mechopt's own, the in-house baselines, the
-    maintained libraries' (the optional ``compare`` extra)."""
-    library = dict(spends_whole_budget=True)
+def _own_records() -> list[Method]:
+    """mechopt's own methods: they run on the sampler and propose batches of designs."""
     return [
         Method(AUTO_METHOD, run_auto, "the default (and of every study that names none): Gaussian-process steps "
                "(Matern-5/2, expected improvement): one global model up to 300 designs, restarted trust regions "
@@ -157,6 +155,14 @@ def _records() -> list[Method]:
                "basins of the blend simulated, then steps on the blend corrected by every simulation", own=True,
                dims=(2, 4), batches=True, min_budget=lambda dim, budget, n_lines: (10 * dim, "10d"), options=(),
                compare_name="mechopt-global"),
+    ]
+
+
+def _baseline_records() -> list[Method]:
+    """The baselines, one design at a time: the in-house ones, then the maintained libraries' (the optional
+    ``compare`` extra), which spend their whole budget."""
+    library = dict(spends_whole_budget=True)
+    return [
         Method("differential_evolution", bl.minimize_differential_evolution, "scipy differential evolution, "
                "best1bin (Storn & Price 1997); constraints by Lampinen's feasibility rules, infeasible trials never "
                "simulated"),
@@ -208,7 +214,7 @@ def _records() -> list[Method]:
 
 
 #: Every method by name, in the order of :func:`available_methods`.
-METHODS: dict[str, Method] = {m.name: m for m in _records()}
+METHODS: dict[str, Method] = {m.name: m for m in [*_own_records(), *_baseline_records()]}
 
 
 def available_methods() -> list[str]:
