@@ -10,6 +10,7 @@ import numpy as np
 
 from mechopt.report.plots import plt
 from mechopt.sim.figure_file import save_figure
+from mechopt.studies.comparison.engine import OWN_METHOD
 from mechopt.studies.comparison.tables import cell_text
 
 __all__ = ["plot_gaps", "plot_headline"]
@@ -26,8 +27,8 @@ def plot_gaps(rows: list[dict], path: Path, threshold_pct: float = 0.5,
         b = np.array([r["budget"] for r in sel])
         # An unfinished cell is not a finished comparison: a gap in the curve, not a point.
         g = np.array([max(r["median_gap_pct"], 1e-8) if r.get("complete", True) else np.nan for r in sel])
-        style = dict(lw=3, color="k", marker="o") if method == "mechopt" else dict(lw=1.3, marker=".")
-        ax.plot(b, np.where(np.isfinite(g), g, np.nan), label=method, color=None if method != "mechopt" else "k",
+        style = dict(lw=3, color="k", marker="o") if method == OWN_METHOD else dict(lw=1.3, marker=".")
+        ax.plot(b, np.where(np.isfinite(g), g, np.nan), label=method, color=None if method != OWN_METHOD else "k",
                 linestyle="-" if i < 10 else "--", **{k: v for k, v in style.items() if k != "color"})
     ax.axhline(threshold_pct, color="C3", ls=":", lw=1, label="reached: within the tolerance of the optimum")
     ax.set_xscale("log")
