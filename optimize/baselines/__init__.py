@@ -3,8 +3,6 @@
 Every baseline has the signature ``minimize_<name>(problem: CountedProblem, seed: int, **options) ->
 OptimizeResult`` and returns the best *feasible* design it simulated (``x``, ``fun``) with the number of simulator
 calls used (``nfev <= problem.budget``); :class:`~mechopt.optimize.budget.CountedProblem` enforces the budget.
-:func:`~optimize.baselines.rbf_surrogate.fit_and_search_rbf` is the surrogate baseline fed with given samples; it is
-not in :data:`BASELINES` because it does not choose its own samples.
 
 :data:`BASELINES` holds the in-house implementations (:data:`IN_HOUSE_BASELINES`) and wrappers of maintained optimizer
 libraries (:data:`LIBRARY_BASELINES`: Optuna, SMT, pymoo, nevergrad).  The libraries are the optional ``compare``
@@ -21,16 +19,13 @@ from scipy.optimize import OptimizeResult
 from mechopt.optimize.baselines.bayesian import minimize_bayesian
 from mechopt.optimize.baselines.differential_evolution import minimize_differential_evolution
 from mechopt.optimize.baselines.dual_annealing import minimize_dual_annealing
-from mechopt.optimize.baselines.genetic import minimize_genetic
 from mechopt.optimize.baselines.library import MissingLibraryError
 from mechopt.optimize.baselines.nelder_mead import minimize_nelder_mead
 from mechopt.optimize.baselines.nevergrad_optimizers import minimize_nevergrad_cma, minimize_nevergrad_ngopt
 from mechopt.optimize.baselines.optuna_samplers import minimize_optuna_cmaes, minimize_optuna_tpe
 from mechopt.optimize.baselines.paper000_hybrid import minimize_paper000_hybrid
-from mechopt.optimize.baselines.particle_swarm import minimize_particle_swarm
 from mechopt.optimize.baselines.powell_penalty import minimize_powell_penalty
 from mechopt.optimize.baselines.pymoo_algorithms import minimize_pymoo_de, minimize_pymoo_ga, minimize_pymoo_pso
-from mechopt.optimize.baselines.rbf_surrogate import fit_and_search_rbf
 from mechopt.optimize.baselines.sce_ua import minimize_sce_ua
 from mechopt.optimize.baselines.slsqp import minimize_slsqp
 from mechopt.optimize.baselines.smt_ego import minimize_smt_ego
@@ -44,18 +39,15 @@ __all__ = [
     "IN_HOUSE_BASELINES",
     "LIBRARY_BASELINES",
     "MissingLibraryError",
-    "fit_and_search_rbf",
     "minimize_bayesian",
     "minimize_differential_evolution",
     "minimize_dual_annealing",
-    "minimize_genetic",
     "minimize_nelder_mead",
     "minimize_nevergrad_cma",
     "minimize_nevergrad_ngopt",
     "minimize_optuna_cmaes",
     "minimize_optuna_tpe",
     "minimize_paper000_hybrid",
-    "minimize_particle_swarm",
     "minimize_powell_penalty",
     "minimize_pymoo_de",
     "minimize_pymoo_ga",
@@ -72,10 +64,8 @@ IN_HOUSE_BASELINES: dict[str, Callable[..., OptimizeResult]] = {
     "nelder_mead": minimize_nelder_mead,
     "slsqp": minimize_slsqp,
     "powell_penalty": minimize_powell_penalty,
-    "genetic": minimize_genetic,
     "paper000_hybrid": minimize_paper000_hybrid,
     "sce_ua": minimize_sce_ua,
-    "particle_swarm": minimize_particle_swarm,
     "bayesian": minimize_bayesian,
 }
 
@@ -106,15 +96,11 @@ BASELINE_DOCS: dict[str, str] = {
     "gradients (the SQP route of paper 003).",
     "powell_penalty": "Powell's conjugate directions (Powell 1964) with Box's sin² bound transform and a "
     "sequence of quadratic exterior penalties (paper 001).",
-    "genetic": "real-coded GA, tournament + SBX + polynomial mutation + elitism (Deb 2001), then multistart "
-    "Nelder-Mead/SLSQP from its best designs (hybrid of paper 000); static quadratic penalty.",
     "paper000_hybrid": "paper 000's hybrid: GA on the dimensions (feasible initial population, SBX, polynomial "
     "mutation, 5 % elitism; λ = 50 quadratic penalty, infeasible children not simulated), then SLSQP from its 100 "
     "best distinct designs.",
     "sce_ua": "shuffled complex evolution (Duan, Sorooshian & Gupta 1992), best of paper 004; feasible-space "
     "rejection with random resampling.",
-    "particle_swarm": "global-best PSO with inertia/constriction coefficients (Clerc & Kennedy 2002); "
-    "feasibility-preserving rejection (Hu & Eberhart 2002).",
     "bayesian": "Bayesian optimisation, Matérn-5/2 GP with ML-II hyperparameters and expected improvement "
     "(Jones, Schonlau & Welch 1998); infeasible candidates rejected before simulation.",
     "optuna_tpe": "Optuna's multivariate TPE (Bergstra et al. 2011), ask/tell; Optuna's constrained TPE "
