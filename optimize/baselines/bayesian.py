@@ -204,7 +204,7 @@ def _acquire(
     incumbent = U[int(np.argmin(np.where(finite, y, np.inf)))]
     cand = np.vstack([rng.random((n_candidates, d)),
                       np.clip(incumbent + 0.05 * rng.standard_normal((n_local_candidates, d)), 0.0, 1.0)])
-    cand = cand[problem.feasible_many(problem.from_unit(cand))]
+    cand = cand[problem.feasible(problem.from_unit(cand))]
     if cand.shape[0] == 0:
         raise BudgetExhausted("no feasible candidate found for the acquisition")
     ei = expected_improvement(*gp.predict(cand), best)
@@ -216,7 +216,7 @@ def _acquire(
 
     for j in top:
         res = minimize(neg_ei, cand[j], method="L-BFGS-B", bounds=[(0.0, 1.0)] * d)
-        if -res.fun > pick_ei and problem.feasible(problem.from_unit(res.x)):
+        if -res.fun > pick_ei and problem.feasible(problem.from_unit(res.x))[0]:
             pick, pick_ei = res.x, -res.fun
     if np.min(np.linalg.norm(U - pick, axis=1)) < 1e-9:
         # EI has collapsed onto a known design: explore instead of re-simulating (cached) forever.

@@ -242,7 +242,7 @@ def test_extended_objective_is_continuous_at_the_boundary() -> None:
     anchor = np.zeros(3)
     direction = np.ones(3) / np.sqrt(3.0)
     on_boundary = problem.boundary_point(anchor, anchor + 3.0 * direction)
-    assert problem.feasible(on_boundary) and np.sum(on_boundary) == pytest.approx(Q_B, abs=1e-12)
+    assert problem.feasible(on_boundary)[0] and np.sum(on_boundary) == pytest.approx(Q_B, abs=1e-12)
     just_outside = on_boundary + 1e-7 * direction
     assert problem.extended(just_outside, anchor) == pytest.approx(quad(on_boundary), abs=1e-5)
     assert all(rec.feasible)
