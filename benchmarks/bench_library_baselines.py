@@ -27,7 +27,7 @@ from mechopt.studies.catalogue import load_study
 T_TRUE = 1.758244
 
 DEFAULT_METHODS = ["optuna_tpe", "optuna_cmaes", "smt_ego", "pymoo_ga", "pymoo_pso", "pymoo_de", "nevergrad_ngopt",
-                   "nevergrad_cma", "bayesian", "genetic", "particle_swarm", "differential_evolution", "slsqp"]
+                   "nevergrad_cma", "bayesian", "differential_evolution", "slsqp"]
 
 
 def ventilator_problem(budget: int) -> tuple[CountedProblem, object]:

@@ -177,16 +177,11 @@ def _baseline_records() -> list[Method]:
                "simulated"),
         Method("powell_penalty", bl.minimize_powell_penalty, "Powell's conjugate directions (Powell 1964) with Box's "
                "sin² bound transform and a sequence of quadratic exterior penalties (paper 001)"),
-        Method("genetic", bl.minimize_genetic, "real-coded GA, tournament + SBX + polynomial mutation + elitism (Deb "
-               "2001), then multistart Nelder-Mead/SLSQP from its best designs (hybrid of paper 000); static "
-               "quadratic penalty"),
         Method("paper000_hybrid", bl.minimize_paper000_hybrid, "paper 000's hybrid: GA on the dimensions (feasible "
                "initial population, SBX, polynomial mutation, 5 % elitism; λ = 50 quadratic penalty, infeasible "
                "children not simulated), then SLSQP from its 100 best distinct designs"),
         Method("sce_ua", bl.minimize_sce_ua, "shuffled complex evolution (Duan, Sorooshian & Gupta 1992), best of "
                "paper 004; feasible-space rejection with random resampling"),
-        Method("particle_swarm", bl.minimize_particle_swarm, "global-best PSO with inertia/constriction coefficients "
-               "(Clerc & Kennedy 2002); feasibility-preserving rejection (Hu & Eberhart 2002)"),
         Method("bayesian", bl.minimize_bayesian, "Bayesian optimisation, Matérn-5/2 GP with ML-II hyperparameters "
                "and expected improvement (Jones, Schonlau & Welch 1998); infeasible candidates rejected before "
                "simulation", max_budget=_at_most(BAYESIAN_MAX_BUDGET)),

@@ -37,17 +37,9 @@ from typing import Any
 import numpy as np
 
 from mechopt.errors import InputError
+from mechopt.optimize.sparse.global_lines import MIN_RUN, FittedLines, blend_basins, line_stage
 from mechopt.optimize.sparse.model_confidence import RESOLVED
 from mechopt.optimize.sparse.model_exploration import DISTANCE_CYCLE, explore
-from mechopt.optimize.sparse_global_lines import (
-    MIN_LINES,
-    MIN_RUN,
-    CountedUnitCube,
-    FittedLines,
-    as_objective,
-    blend_basins,
-    line_stage,
-)
 from mechopt.surrogate import SparseExponentialModel
 from mechopt.surrogate.basins import Minima, thin
 
@@ -55,6 +47,9 @@ __all__ = ["GlobalSearchResult", "global_search"]
 
 Predicate = Callable[[np.ndarray], np.ndarray]
 BatchEvaluator = Callable[[np.ndarray], np.ndarray]
+
+#: Fewest lines of a plan, per dimension (the blend needs more nodes than its normal plane has dimensions).
+_MIN_LINES = {2: 3, 3: 4, 4: 5}
 
 
 @dataclass
@@ -103,6 +98,71 @@ class GlobalSearchResult:
     history_x: np.ndarray
     history_f: np.ndarray
     stages: list[dict[str, Any]] = field(default_factory=list)
+
+
+class _Counted:
+    """The batch evaluator behind a hard budget, in unit-cube coordinates, remembering every value and its source."""
+
+    def __init__(self, evaluate: BatchEvaluator, lower: np.ndarray, width: np.ndarray, budget: int):
+        self.evaluate = evaluate
+        self.lower, self.width = lower, width
+        self.budget = budget
+        self.Z: list[np.ndarray] = []
+        self.f: list[float] = []
+        self.source: list[str] = []
+        self._memo: dict[bytes, float] = {}
+
+    @property
+    def nfev(self) -> int:
+        return len(self.f)
+
+    @property
+    def remaining(self) -> int:
+        return self.budget - self.nfev
+
+    def x(self, Z: np.ndarray) -> np.ndarray:
+        return self.lower + np.atleast_2d(Z) * self.width
+
+    def __call__(self, Z: np.ndarray, source: str) -> np.ndarray:
+        """Values at unit-cube designs Z (n, d); repeated designs are free, designs beyond the budget get NaN."""
+        Z = np.atleast_2d(np.asarray(Z, dtype=float))
+        out = np.full(Z.shape[0], np.nan)
+        todo, keys = [], []
+        for j, z in enumerate(Z):
+            key = z.tobytes()
+            if key in self._memo:
+                out[j] = self._memo[key]
+            elif key not in keys and len(todo) < self.remaining:
+                todo.append(j)
+                keys.append(key)
+        if todo:
+            values = np.asarray(self.evaluate(self.x(Z[todo])), dtype=float).reshape(-1)
+            if values.size != len(todo):
+                raise InputError(f"evaluate returned {values.size} values for {len(todo)} designs")
+            for j, key, v in zip(todo, keys, values, strict=True):
+                v = float(v) if math.isfinite(v) else math.nan
+                self._memo[key] = v
+                self.Z.append(Z[j].copy())
+                self.f.append(v)
+                self.source.append(source)
+        for j, z in enumerate(Z):
+            out[j] = self._memo.get(z.tobytes(), np.nan)
+        return out
+
+    def best(self, feasible: Predicate) -> tuple[np.ndarray, float, str]:
+        if not self.f:
+            return np.full(self.lower.size, np.nan), math.nan, ""
+        f = np.array(self.f)
+        ok = np.isfinite(f) & feasible(np.array(self.Z))
+        if not ok.any():
+            return np.full(self.lower.size, np.nan), math.nan, ""
+        j = int(np.flatnonzero(ok)[np.argmin(f[ok])])
+        return self.Z[j], float(f[j]), self.source[j]
+
+
+def _as_objective(fit: str, value: np.ndarray) -> np.ndarray:
+    value = np.asarray(value, dtype=float)
+    return np.sqrt(np.maximum(value, 0.0)) if fit == "square" else value
 
 
 def global_search(evaluate: BatchEvaluator, bounds: Any, feasible: Predicate, sampleable: Predicate | None = None,
@@ -223,7 +283,7 @@ class _GlobalRun:
         self.dim = bounds.shape[0]
         self.budget, self.fit = budget, fit
         self.feas_z, self.samp_z = self._in_unit_cube(feasible), self._in_unit_cube(sampleable)
-        self.counted = CountedUnitCube(evaluate, self.lower, self.width, int(budget))
+        self.counted = _Counted(evaluate, self.lower, self.width, int(budget))
         self.models: dict[str, SparseExponentialModel] = {}
         self.cand_z: list[np.ndarray] = []
         self.cand_f: list[float] = []
@@ -241,7 +301,7 @@ class _GlobalRun:
         optimistic bound simulated.  None when no line plan or fit exists."""
         counted, dim = self.counted, self.dim
         n_global = int(round(global_share * self.budget))
-        l_global = n_lines or max(MIN_LINES[dim], n_global // samples_per_line)
+        l_global = n_lines or max(_MIN_LINES[dim], n_global // samples_per_line)
         n_global = max(n_global, MIN_RUN * l_global)
         zero, one = np.zeros(dim), np.ones(dim)
         glob = line_stage(counted, zero, one, self.feas_z, self.samp_z, l_global, samples_per_line, n_global,
@@ -275,7 +335,7 @@ class _GlobalRun:
         for z, fz, p in zip(pts.x, f, pts.value, strict=True):
             self.cand_z.append(z)
             self.cand_f.append(float(fz))
-            self.cand_pred.append(float(as_objective(self.fit, p)))
+            self.cand_pred.append(float(_as_objective(self.fit, p)))
 
     def _record_claim(self, by_model: Minima, first: int) -> None:
         """How far the model's own claim (its best minimum, simulated first among the candidates from ``first``)

@@ -257,7 +257,8 @@ def _neg_log_posterior(theta: np.ndarray, X: np.ndarray, y: np.ndarray, prior_mu
 
 
 def fit_gp(X: np.ndarray, y: np.ndarray, rng: np.random.Generator, warm: np.ndarray | None = None,
-           starts: int = 3, maxiter: int = 100, prior: bool = True, spacing_floor: bool = False) -> GaussianProcess:
+           starts: int = 3, maxiter: int = 100, prior: bool = True, spacing_floor: bool = False,
+           additive: bool = True, quadratic: bool | None = None) -> GaussianProcess:
     """Fit the hyperparameters by L-BFGS-B on the log posterior from ``starts`` points and keep the best.
 
     Parameters
@@ -279,6 +280,10 @@ def fit_gp(X: np.ndarray, y: np.ndarray, rng: np.random.Generator, warm: np.ndar
     spacing_floor : bool
         When the fitted model correlates no design with its nearest neighbour (:func:`_sees_no_neighbour`), fit it
         again with no length-scale shorter than half the designs' median nearest-neighbour distance.
+    additive : bool
+        Fit the first-order additive component beside the product kernel (default), or the product kernel alone.
+    quadratic : bool, optional
+        The prior mean's form (:class:`GaussianProcess`); default: quadratic where the designs pay for it.
 
     Notes
     -----
@@ -294,10 +299,11 @@ def fit_gp(X: np.ndarray, y: np.ndarray, rng: np.random.Generator, warm: np.ndar
     applied at every fit took Michalewicz-3, whose wells are narrower than the designs' spacing, to 21 %, and
     Styblinski-Tang-3 to 3.0 % (the additive component, which shares the length-scales, lost its share).
     """
-    gp = _fit(X, y, rng, warm, starts, maxiter, prior, _LOG_ELL[0])
+    gp = _fit(X, y, rng, warm, starts, maxiter, prior, _LOG_ELL[0], additive, quadratic)
     if spacing_floor and X.shape[0] > 1 and _sees_no_neighbour(gp):
         floor = math.log(max(0.5 * _median_spacing(X), 1e-12))
-        gp = _fit(X, y, rng, None, starts, maxiter, prior, min(max(_LOG_ELL[0], floor), _LOG_ELL[1]))
+        gp = _fit(X, y, rng, None, starts, maxiter, prior, min(max(_LOG_ELL[0], floor), _LOG_ELL[1]), additive,
+                  quadratic)
     return gp
 
 
@@ -321,32 +327,33 @@ def _prior_mean(d: int) -> float:
 
 
 def _fit(X: np.ndarray, y: np.ndarray, rng: np.random.Generator, warm: np.ndarray | None, starts: int,
-         maxiter: int, prior: bool, log_ell_min: float) -> GaussianProcess:
+         maxiter: int, prior: bool, log_ell_min: float, additive: bool = True,
+         quadratic: bool | None = None) -> GaussianProcess:
     """:func:`fit_gp` with ``log_ell_min`` as the lower bound of every log length-scale."""
     d = X.shape[1]
     prior_mu = _prior_mean(d)
     log_ell = (log_ell_min, _LOG_ELL[1])
-    bounds = [log_ell] * d + [_LOG_SIGNAL, _LOG_NOISE, _LOG_ADDITIVE]
+    bounds = [log_ell] * d + [_LOG_SIGNAL, _LOG_NOISE] + ([_LOG_ADDITIVE] if additive else [])
     lo, hi = np.array(bounds).T
-    if warm is not None and warm.size == d + 2:
-        # The previous fit left the additive component out (below): it restarts from where it was left.
-        warm = np.append(warm, _LOG_ADDITIVE[0])
+    if warm is not None:
+        # A previous fit that left the additive component out (below) restarts it from where it was left.
+        warm = np.append(warm, _LOG_ADDITIVE[0]) if additive and warm.size == d + 2 else warm[: len(bounds)]
     cands = [] if warm is None else [np.clip(warm, lo, hi)]
     while len(cands) < max(starts, 1):
         ell = np.clip(prior_mu + math.sqrt(3.0) * rng.standard_normal(d), *log_ell)
-        cands.append(np.concatenate([ell, [0.0, math.log(1e-4), _LOG_ADDITIVE_START]]))
+        cands.append(np.concatenate([ell, [0.0, math.log(1e-4)] + ([_LOG_ADDITIVE_START] if additive else [])]))
     best, best_val = cands[0], np.inf
     for theta0 in cands:
         res = minimize(_neg_log_posterior, theta0, args=(X, y, prior_mu, float(prior)), jac=True, method="L-BFGS-B",
                        bounds=bounds, options={"maxiter": maxiter, "ftol": _FTOL})
         if res.fun < best_val:
             best, best_val = res.x, res.fun
-    if best[d + 2] < best[d] + _NEGLIGIBLE:
+    if additive and best[d + 2] < best[d] + _NEGLIGIBLE:
         # The evidence gave the additive component (next to) nothing: the model is the product kernel's, and
         # predicting without the component's d terms a pair of designs is cheaper (Hartmann-6 at 300 simulations:
         # 55 s of the method's own time instead of 65 s).
         best = best[: d + 2]
-    return GaussianProcess(X, y, best)
+    return GaussianProcess(X, y, best, quadratic)
 
 
 def noise_log_bayes_factor(gp: GaussianProcess, n: int, prior: bool, null_noise: float) -> float:

@@ -3,8 +3,6 @@
 Every baseline has the signature ``minimize_<name>(problem: CountedProblem, seed: int, **options) ->
 OptimizeResult`` and returns the best *feasible* design it simulated (``x``, ``fun``) with the number of simulator
 calls used (``nfev <= problem.budget``); :class:`~mechopt.optimize.budget.CountedProblem` enforces the budget.
-:func:`~optimize.baselines.rbf_surrogate.fit_and_search_rbf` is the surrogate baseline fed with given samples; it is
-not a method because it does not choose its own samples.
 
 The table of methods (:data:`mechopt.optimize.methods.METHODS`) names each baseline, with its summary.  Besides the
 in-house implementations, some wrap maintained optimizer libraries (Optuna, SMT, pymoo, nevergrad): the optional
@@ -18,16 +16,13 @@ from mechopt.optimize.baselines.bayesian import minimize_bayesian
 from mechopt.optimize.baselines.cobyqa import minimize_cobyqa
 from mechopt.optimize.baselines.differential_evolution import minimize_differential_evolution
 from mechopt.optimize.baselines.dual_annealing import minimize_dual_annealing
-from mechopt.optimize.baselines.genetic import minimize_genetic
 from mechopt.optimize.baselines.library import MissingLibraryError
 from mechopt.optimize.baselines.nelder_mead import minimize_nelder_mead
 from mechopt.optimize.baselines.nevergrad_optimizers import minimize_nevergrad_cma, minimize_nevergrad_ngopt
 from mechopt.optimize.baselines.optuna_samplers import minimize_optuna_cmaes, minimize_optuna_tpe
 from mechopt.optimize.baselines.paper000_hybrid import minimize_paper000_hybrid
-from mechopt.optimize.baselines.particle_swarm import minimize_particle_swarm
 from mechopt.optimize.baselines.powell_penalty import minimize_powell_penalty
 from mechopt.optimize.baselines.pymoo_algorithms import minimize_pymoo_de, minimize_pymoo_ga, minimize_pymoo_pso
-from mechopt.optimize.baselines.rbf_surrogate import fit_and_search_rbf
 from mechopt.optimize.baselines.sce_ua import minimize_sce_ua
 from mechopt.optimize.baselines.slsqp import minimize_slsqp
 from mechopt.optimize.baselines.smt_ego import minimize_smt_ego
@@ -37,19 +32,16 @@ __all__ = [
     "BudgetExhausted",
     "CountedProblem",
     "MissingLibraryError",
-    "fit_and_search_rbf",
     "minimize_bayesian",
     "minimize_cobyqa",
     "minimize_differential_evolution",
     "minimize_dual_annealing",
-    "minimize_genetic",
     "minimize_nelder_mead",
     "minimize_nevergrad_cma",
     "minimize_nevergrad_ngopt",
     "minimize_optuna_cmaes",
     "minimize_optuna_tpe",
     "minimize_paper000_hybrid",
-    "minimize_particle_swarm",
     "minimize_powell_penalty",
     "minimize_pymoo_de",
     "minimize_pymoo_ga",

@@ -78,7 +78,7 @@ def _constrained_ego(ego_class: type, problem: CountedProblem, rng: np.random.Ge
                 res = minimize(neg_ei, u0, method="SLSQP", bounds=[(0.0, 1.0)] * d, constraints=cons,
                                options={"maxiter": 200})
                 u = np.clip(res.x, 0.0, 1.0)
-                if np.isfinite(res.fun) and res.fun < best_val and problem.feasible(problem.from_unit(u)):
+                if np.isfinite(res.fun) and res.fun < best_val and problem.feasible(problem.from_unit(u))[0]:
                     best_u, best_val = u, float(res.fun)
             if best_u is None or np.min(np.linalg.norm(x_data - best_u, axis=1)) < 1e-9:
                 extra = problem.to_unit(problem.sample_feasible(1, rng))

@@ -29,7 +29,7 @@ def gradient_designs(problem: CountedProblem, x: np.ndarray, step: float = 1e-5)
         forward, backward = x.copy(), x.copy()
         forward[i] += h
         backward[i] -= h
-        forward_side.append(bool(problem.feasible(forward) or not problem.feasible(backward)
+        forward_side.append(bool(problem.feasible(forward)[0] or not problem.feasible(backward)[0]
                                  and forward[i] <= problem.upper[i]))
         points.append(forward if forward_side[-1] else backward)
     return points, forward_side
@@ -101,7 +101,7 @@ def local_slsqp(
     anchor = [problem.clip(np.asarray(x0, dtype=float))]
 
     def extended(x: np.ndarray) -> float:
-        if problem.feasible(x):
+        if problem.feasible(x)[0]:
             anchor[0] = x
         f = problem.extended(x, anchor[0])
         return f if math.isfinite(f) else problem.infeasible_value

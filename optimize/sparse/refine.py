@@ -116,7 +116,7 @@ def _speculate(sampler: Sampler, problem: CountedProblem, x: np.ndarray, fd_step
         return
     if left <= 0:
         raise BudgetExhausted("the refinement's budget is spent")
-    points = [p for p in gradient_designs(problem, x, fd_step)[0] if problem.feasible(p)]
+    points = [p for p in gradient_designs(problem, x, fd_step)[0] if problem.feasible(p)[0]]
     sampler(np.vstack([x, *points])[:left], desc="refinement")
 
 
@@ -146,7 +146,7 @@ class _BatchedProblem(CountedProblem):
             if left <= 0:
                 break
             left -= 1  # an infeasible design costs one simulation too (its boundary point): counted, not fetched
-            if self.feasible(x):
+            if self.feasible(x)[0]:
                 keys.add(key)
                 todo.append(x)
         if len(todo) > 1:

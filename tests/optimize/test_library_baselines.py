@@ -232,25 +232,9 @@ def median_gap(name: str, budget: int, seeds=range(3)) -> float:
     return float(np.median(gaps))
 
 
-def test_pymoo_pso_is_at_least_as_good_as_the_in_house_pso() -> None:
-    # Measured (seeds 0-2, 300 calls): pymoo's adaptive PSO 1.7e-3, 3.9e-3, 4.2e-3; in-house constriction PSO
-    # 6.0e-2, 3.2e-2, 4.2e-2.
-    library, in_house = median_gap("pymoo_pso", 300), median_gap("particle_swarm", 300)
-    assert library <= 1e-2 and in_house <= 0.1
-    assert library <= in_house
-
-
-def test_in_house_hybrid_ga_beats_pymoo_plain_ga() -> None:
-    # Measured (seeds 0-2, 300 calls): in-house GA + Nelder-Mead polish 1.1e-2, 1.5e-3, 1.8e-2; pymoo's GA 4.5e-2,
-    # 9.6e-2, 9.1e-3.  The in-house method is paper 000's hybrid, not a plain GA: it is kept.
-    library, in_house = median_gap("pymoo_ga", 300), median_gap("genetic", 300)
-    assert in_house <= 5e-2 and library <= 0.1
-    assert in_house <= library
-
-
 def test_smt_ego_is_at_least_as_good_as_the_in_house_bayesian_optimizer() -> None:
-    # Measured (seeds 0-2, 12 calls, 4 of them the initial design in both): SMT EGO 4.9e-2, 7.5e-2, 5.3; in-house
-    # GP-EI 5.8, 2.0, 0.33; random search 3.9, 4.0, 1.7.
+    # Measured (seeds 0-2, 12 calls, 4 of them the initial design in both): SMT EGO 4.7e-2, 8.5e-2, 5.3; in-house
+    # GP-EI 9.4e-2, 0.83, 4.5; random search 3.9, 4.0, 1.7.
     library, in_house = median_gap("smt_ego", 12), median_gap("bayesian", 12)
     assert library <= 0.3
     assert library <= in_house

@@ -1,12 +1,12 @@
-"""The line stage of the global sparse strategy (:mod:`mechopt.optimize.sparse_global`): a batch evaluator behind a
-hard budget in unit-cube coordinates, lines planned over a box, sampled and fitted, and the basins of their blend.
+"""The first two steps of the global sparse strategy (:mod:`mechopt.optimize.sparse_global`): global lines planned
+over a region, sampled, fitted and blended; then the basins of the blend and of its optimistic bound
+``blend − κ·spread``, the places worth a simulation.
 
-Everything runs in the unit cube of the bounds, so a radius or a width is a fraction of the box.
+Everything is in unit-cube coordinates; the values come from a counted batch evaluator ``counted(Z, source)``.
 """
 
 from __future__ import annotations
 
-import math
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -19,80 +19,18 @@ from mechopt.surrogate.basins import Minima, field_minima, thin
 from mechopt.surrogate.errors import SurrogateWarning
 from mechopt.surrogate.line_error import LineOutError, blend_spread, leave_one_line_out
 
-__all__ = ["BASIN_GRID", "MIN_LINES", "MIN_RUN", "SEARCH_POINTS", "CountedUnitCube", "FittedLines", "as_objective",
-           "blend_basins", "box_predicate", "line_stage", "longest_finite_run", "trim_plan"]
+__all__ = ["MIN_RUN", "FittedLines", "blend_basins", "box_predicate", "line_stage", "longest_finite_run", "trim_plan"]
 
 Predicate = Callable[[np.ndarray], np.ndarray]
-BatchEvaluator = Callable[[np.ndarray], np.ndarray]
+#: Values at unit-cube designs Z (n, d), the second argument naming the step that asked (NaN beyond the budget).
+CountedEvaluator = Callable[[np.ndarray, str], np.ndarray]
 
 #: Grid points per axis of the basin search (d = 2, 3, 4).
-BASIN_GRID = {2: 121, 3: 33, 4: 15}
+_GRID = {2: 121, 3: 33, 4: 15}
 #: Grid points of the exhaustive search of a blend (paper 002: 10 million for its single model).
-SEARCH_POINTS = {2: 40_000, 3: 200_000, 4: 400_000}
-#: Fewest lines of a plan, per dimension (the blend needs more nodes than its normal plane has dimensions).
-MIN_LINES = {2: 3, 3: 4, 4: 5}
+_SEARCH_POINTS = {2: 40_000, 3: 200_000, 4: 400_000}
 #: Fewest samples a line keeps (a sum of exponentials of order 1 with a constant needs 4).
 MIN_RUN = 4
-
-
-class CountedUnitCube:
-    """The batch evaluator behind a hard budget, in unit-cube coordinates, remembering every value and its source."""
-
-    def __init__(self, evaluate: BatchEvaluator, lower: np.ndarray, width: np.ndarray, budget: int):
-        self.evaluate = evaluate
-        self.lower, self.width = lower, width
-        self.budget = budget
-        self.Z: list[np.ndarray] = []
-        self.f: list[float] = []
-        self.source: list[str] = []
-        self._memo: dict[bytes, float] = {}
-
-    @property
-    def nfev(self) -> int:
-        return len(self.f)
-
-    @property
-    def remaining(self) -> int:
-        return self.budget - self.nfev
-
-    def x(self, Z: np.ndarray) -> np.ndarray:
-        return self.lower + np.atleast_2d(Z) * self.width
-
-    def __call__(self, Z: np.ndarray, source: str) -> np.ndarray:
-        """Values at unit-cube designs Z (n, d); repeated designs are free, designs beyond the budget get NaN."""
-        Z = np.atleast_2d(np.asarray(Z, dtype=float))
-        out = np.full(Z.shape[0], np.nan)
-        todo, keys = [], []
-        for j, z in enumerate(Z):
-            key = z.tobytes()
-            if key in self._memo:
-                out[j] = self._memo[key]
-            elif key not in keys and len(todo) < self.remaining:
-                todo.append(j)
-                keys.append(key)
-        if todo:
-            values = np.asarray(self.evaluate(self.x(Z[todo])), dtype=float).reshape(-1)
-            if values.size != len(todo):
-                raise InputError(f"evaluate returned {values.size} values for {len(todo)} designs")
-            for j, key, v in zip(todo, keys, values, strict=True):
-                v = float(v) if math.isfinite(v) else math.nan
-                self._memo[key] = v
-                self.Z.append(Z[j].copy())
-                self.f.append(v)
-                self.source.append(source)
-        for j, z in enumerate(Z):
-            out[j] = self._memo.get(z.tobytes(), np.nan)
-        return out
-
-    def best(self, feasible: Predicate) -> tuple[np.ndarray, float, str]:
-        if not self.f:
-            return np.full(self.lower.size, np.nan), math.nan, ""
-        f = np.array(self.f)
-        ok = np.isfinite(f) & feasible(np.array(self.Z))
-        if not ok.any():
-            return np.full(self.lower.size, np.nan), math.nan, ""
-        j = int(np.flatnonzero(ok)[np.argmin(f[ok])])
-        return self.Z[j], float(f[j]), self.source[j]
 
 
 @dataclass
@@ -118,6 +56,7 @@ def trim_plan(plan: LinePlan, max_samples: int) -> LinePlan:
 
 
 def longest_finite_run(values: np.ndarray) -> slice:
+    """The longest stretch of consecutive finite values."""
     ok = np.concatenate(([False], np.isfinite(values), [False])).astype(np.int8)
     edges = np.flatnonzero(np.diff(ok))
     if edges.size == 0:
@@ -128,6 +67,7 @@ def longest_finite_run(values: np.ndarray) -> slice:
 
 
 def box_predicate(lo: np.ndarray, hi: np.ndarray, inner: Predicate) -> Predicate:
+    """``inner`` restricted to the box [lo, hi] (a rounding's width beyond its faces allowed)."""
     def pred(Z: np.ndarray) -> np.ndarray:
         Z = np.atleast_2d(Z)
         ok = np.all((Z >= lo - 1e-12) & (Z <= hi + 1e-12), axis=1)
@@ -137,7 +77,7 @@ def box_predicate(lo: np.ndarray, hi: np.ndarray, inner: Predicate) -> Predicate
     return pred
 
 
-def line_stage(counted: CountedUnitCube, lo: np.ndarray, hi: np.ndarray, feasible: Predicate, sampleable: Predicate,
+def line_stage(counted: CountedEvaluator, lo: np.ndarray, hi: np.ndarray, feasible: Predicate, sampleable: Predicate,
                 n_lines: int, samples_per_line: int, max_samples: int, fit: str, max_order: int, seed: int,
                 source: str) -> FittedLines | None:
     """Plan lines over [lo, hi] ∩ feasible, sample them (capped), fit and blend; None if no plan or fit exists."""
@@ -197,11 +137,11 @@ def blend_basins(fitted: FittedLines, lo: np.ndarray, hi: np.ndarray, feasible: 
             ok[ok] = np.asarray(feasible(Z[ok]), dtype=bool).reshape(-1)
         return ok
 
-    n = BASIN_GRID[lo.size]
+    n = _GRID[lo.size]
     by_model = field_minima(lambda Z: model.predict(Z), lo, hi, region, n, radius, n_model)
     # The paper's own answer, the exhaustive search of the blend (finer grid, polished), leads the model's minima.
     found = exhaustive_search(model, feasible=lambda Z: feasible(Z) & box_predicate(lo, hi, feasible)(Z),
-                              n_points=SEARCH_POINTS[lo.size])
+                              n_points=_SEARCH_POINTS[lo.size])
     if found.success:
         by_model = thin(np.vstack([found.x[None, :], by_model.x]), np.concatenate([[found.fun], by_model.value]),
                         radius, n_model)
@@ -214,8 +154,3 @@ def blend_basins(fitted: FittedLines, lo: np.ndarray, hi: np.ndarray, feasible: 
     else:
         by_bound = Minima(np.zeros((0, lo.size)), np.zeros(0))
     return by_model, by_bound
-
-
-def as_objective(fit: str, value: np.ndarray) -> np.ndarray:
-    value = np.asarray(value, dtype=float)
-    return np.sqrt(np.maximum(value, 0.0)) if fit == "square" else value
