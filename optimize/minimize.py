@@ -164,7 +164,7 @@ def _account(result: OptimizeResult, sampler: Sampler) -> None:
 
 
 def parallel_accounting(sampler: Sampler) -> dict[str, Any]:
-    """``rounds``, ``batch_size``, ``idle_share``, ``waiting_s`` and ``method_s`` of a run so far (issue 28)."""
+    """``rounds``, ``batch_size``, ``idle_share``, ``waiting_s`` and ``method_s`` of a run so far."""
     timing = sampler.timing()
     return {"rounds": timing["rounds"], "batch_size": sampler.batch_size, "idle_share": timing["idle_share"],
             "waiting_s": timing["waiting_s"], "method_s": timing["method_s"]}
@@ -321,7 +321,7 @@ def _sparse_global(problem: DesignProblem, budget: int, seed: int, sampler: Samp
 def _handed_to_auto(problem: DesignProblem, opts: SparseOptions, sampler: Sampler, why: str,
                     log: Callable[[str], None]) -> OptimizeResult:
     """The rest of the budget to the default method, which learns where the simulator fails, with every design the
-    line model simulated as its start (failed simulations must not end a run: issue 22)."""
+    line model simulated as its start (failed simulations must not end a run)."""
     left = int(opts.budget) - len(sampler.designs)
     log(f"  {why}: the remaining {left} simulations go to method 'auto'")
     initial = np.array([d for d, _ in sampler.history.values()]) if sampler.history else None
