@@ -154,7 +154,7 @@ def _account(result: OptimizeResult, sampler: Sampler) -> None:
 
 
 def parallel_accounting(sampler: Sampler) -> dict[str, Any]:
-    """``rounds``, ``batch_size``, ``idle_share``, ``waiting_s`` and ``method_s`` of a run so far (issue 28)."""
+    """``rounds``, ``batch_size``, ``idle_share``, ``waiting_s`` and ``method_s`` of a run so far."""
     timing = sampler.timing()
     return {"rounds": timing["rounds"], "batch_size": sampler.batch_size, "idle_share": timing["idle_share"],
             "waiting_s": timing["waiting_s"], "method_s": timing["method_s"]}

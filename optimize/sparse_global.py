@@ -1,4 +1,4 @@
-"""The sparse line model made global on multimodal landscapes (issue 15).
+"""The sparse line model made global on multimodal landscapes.
 
 Paper 002's method — samples on l parallel lines, a sum of exponentials per line, a Chebyshev blend across the lines,
 an exhaustive search of the blend — resolves only features wider than the line spacing: between lines the blend
@@ -16,9 +16,8 @@ strategy here keeps the method and stops trusting the model's single answer:
    simulated design that cycles from a fifth of the box to none, one simulation a step.  Where the blend was wrong
    between its lines, the step after one simulation there knows it; where nothing was simulated, the blend's shape
    still guides.  The last ``exploit_share`` of the budget steps at the corrected model's own minimum and takes the
-   best basin to its bottom.  (Measured against the earlier zooms and finite-difference local searches: at 60
-   evaluations Hartmann-3 within 0.5 % of its range in 10 seeds of 10 instead of 8, the cosine function in 8 instead
-   of 0, Himmelblau's disc in 10 instead of 4; ``benchmarks/bench_multimodal.py``.)
+   best basin to its bottom.  Local line plans (zooms) and finite-difference local searches in their place end
+   more runs in a wrong basin (``docs/guide/design-evidence.md``).
 4. The best SIMULATED design is the answer; the model never reports a value of its own.  A trust report gives the
    leave-one-line-out error of the global blend relative to the sampled range, how far the model's own claim was
    from the simulation, and which step produced the winner.
@@ -222,7 +221,7 @@ def global_search(evaluate: BatchEvaluator, bounds: Any, feasible: Predicate, sa
         Take the steps on the corrected blend (False: the lines and the blend's basins only, what the line model
         alone finds; the rest of the budget is not spent).
     batch : int
-        Designs evaluated at once (issue 28): steps on the corrected blend, and more basins; 1 (default): as ever.
+        Designs evaluated at once: steps on the corrected blend, and more basins; 1 (default): as ever.
 
     Returns
     -------
@@ -235,7 +234,7 @@ def global_search(evaluate: BatchEvaluator, bounds: Any, feasible: Predicate, sa
     """
     b = _checked_bounds(bounds, fit, budget, global_share, exploit_share, cycle)
     if n_candidates is None:
-        # The basins are one round whatever their number: free workers simulate more of them (issue 28).
+        # The basins are one round whatever their number: free workers simulate more of them.
         n_candidates = max(int(np.clip(budget // 40, 1, 4)), min(4, math.ceil(batch / 2)))
     run = _GlobalRun(evaluate, b, feasible, feasible if sampleable is None else sampleable, budget, fit)
     glob = run.global_stage(global_share, samples_per_line, n_lines, max_order, seed, kappa, n_candidates,

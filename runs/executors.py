@@ -164,8 +164,8 @@ class ProcessExecutor(SampleExecutor):
         self._pool: ProcessPoolExecutor | None = ProcessPoolExecutor(
             max_workers=workers, mp_context=_mp_context(), initializer=_start_worker
         )
-        # Start the workers now, in the background, while the method plans its first designs (issue 28: on a busy
-        # machine a cold start of 8 workers took seconds, before the first simulation).
+        # Start the workers now, in the background, while the method plans its first designs: on a busy machine a
+        # cold start of 8 workers takes seconds, which would otherwise come before the first simulation.
         threading.Thread(target=_warm_up, args=(self._pool, workers), name="mechopt-pool-warm-up", daemon=True).start()
 
     def map_unordered(self, fn: Callable[[T], R], items: Iterable[T]) -> Iterator[R]:

@@ -42,7 +42,7 @@ class PlanStage:
     held : int
         Of those, how many the store already holds (not simulated again).
     parallel : bool
-        Whether its designs run ``workers`` at a time (lines, held-out lines, and since issue 28 every step of the
+        Whether its designs run ``workers`` at a time (lines, held-out lines, and every step of the
         sparse methods, proposed in batches of ``workers``) or one after the other (the baselines).
     exact : bool
         Whether ``simulations`` is the count (True) or an upper bound (the refinement may stop earlier).
@@ -281,7 +281,7 @@ def plan_validation(study: Study, options: SparseOptions, store: SampleStore | N
 def _refinement(left: int, workers: int, dim: int) -> list[PlanStage]:
     """The sparse method's refinement: one stage one at a time; with batches, the model steps in rounds of
     ``workers`` (whole rounds of their share of what is left, as the pipeline takes them) and the local search's
-    designs with their gradients, d + 1 a round (issue 28)."""
+    designs with their gradients, d + 1 a round."""
     from mechopt.optimize.sparse.pipeline import model_step_budget
 
     if workers <= 1:

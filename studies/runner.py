@@ -147,7 +147,7 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
         references = _references(study, result.x, sampler)
         timings["references_s"] = time.perf_counter() - t0
         # The rounds, waiting and computing of the whole run (validation and references included) and, apart, of
-        # the optimisation alone (issue 28).
+        # the optimisation alone.
         sampling = {**sampler.summary(), "optimisation": n_opt, "validation": n_val,
                     "references": len(sampler.designs) - n_opt - n_val, "optimisation_timing": timing}
         failures = [(np.array(d), e) for d, e in sampler.failures.values()]
@@ -316,7 +316,7 @@ def _simulations_line(run: StudyRun) -> str:
 
 
 def rounds_text(s: dict[str, Any]) -> str:
-    """The parallel accounting of a run (issue 28): rounds, the workers' idle share, waiting and computing.
+    """The parallel accounting of a run: rounds, the workers' idle share, waiting and computing.
 
     A round is as the plan printed before the run counts it: simulations one after the other, up to ``workers`` at
     a time (the sampler's ``waves``; 8 Sobol designs on 2 workers are 4 rounds).  The method's calls to the

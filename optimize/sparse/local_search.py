@@ -21,7 +21,7 @@ __all__ = ["feasible_side_gradient", "gradient_designs", "local_slsqp"]
 
 def gradient_designs(problem: CountedProblem, x: np.ndarray, step: float = 1e-5) -> tuple[list[np.ndarray], list[bool]]:
     """The d designs :func:`feasible_side_gradient` asks for at ``x`` (and whether each is the forward one): known
-    before any simulation, so that they can be simulated together (issue 28)."""
+    before any simulation, so that they can be simulated together."""
     x = np.asarray(x, dtype=float)
     points, forward_side = [], []
     for i in range(x.size):
@@ -59,8 +59,8 @@ def feasible_side_gradient(
     points, forward_side = gradient_designs(problem, x, step)
     prefetch = getattr(problem, "prefetch", None)
     if prefetch is not None:
-        # A problem that can simulate several designs at once gets the d + 1 designs of the gradient together
-        # (issue 28); the calls below then find them.
+        # A problem that can simulate several designs at once gets the d + 1 designs of the gradient together, as
+        # one round of the workers; the calls below then find them.
         prefetch(np.vstack([x, *points]))
     f0 = fun(x)
     g = np.zeros(x.size)

@@ -105,7 +105,7 @@ def _gauss_newton(space: ModelSpace, sampler: Sampler, x0: np.ndarray, budget: i
 
 
 def _speculate(sampler: Sampler, problem: CountedProblem, x: np.ndarray, fd_step: float, left: int) -> None:
-    """A new design of the search goes out with the d designs of its gradient, in one round (issue 28).
+    """A new design of the search goes out with the d designs of its gradient, in one round.
 
     SLSQP asks for the gradient at nearly every design it simulates (the full step is accepted); the d + 1 designs
     then cost one round instead of two.  A design its line search rejects wastes its d gradient designs: the
@@ -121,7 +121,7 @@ def _speculate(sampler: Sampler, problem: CountedProblem, x: np.ndarray, fd_step
 
 
 class _BatchedProblem(CountedProblem):
-    """A counted problem whose finite-difference gradients simulate their d points as one batch (issue 28).
+    """A counted problem whose finite-difference gradients simulate their d points as one batch.
 
     :func:`~mechopt.optimize.sparse.local_search.feasible_side_gradient` announces the designs it is about to ask
     for through :meth:`prefetch`; they are simulated together (at most what the budget still allows, in the order
