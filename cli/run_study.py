@@ -31,6 +31,7 @@ from mechopt.optimize.sparse.sampler import Sampler
 from mechopt.optimize.sparse.space import ModelSpace
 from mechopt.optimize.sparse.validate import Validation, validate
 from mechopt.runs.executors import check_reachable, default_workers, make_executor
+from mechopt.runs.run_journal import RunJournal, describe_run
 from mechopt.runs.store import SampleStore
 from mechopt.studies.catalogue import Study
 
@@ -127,8 +128,13 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
     with SampleStore(store_path) as store, make_executor(workers=workers, scheduler=scheduler) as executor:
         sampler = Sampler(problem, store, executor, progress, retry_failed)
         plan = plan_run(study, options, method, store, executor.workers, retry_failed)
-        for line in [*study_header(study), f"  store {store_path}, {sampler.executor_description}", *plan.text()]:
+        opening = [*study_header(study), f"  store {store_path}, {sampler.executor_description}", *plan.text()]
+        for line in opening:
             log(line)
+        # The journal in the store lets `mechopt dashboard` show the run from the store alone.
+        journal = RunJournal(store_path, sampler.fingerprint, study.name, describe_run(
+            problem, plan, method, opening, out, store.count(sampler.fingerprint)))
+        log = journal.tee(log)
         t0 = time.perf_counter()
         share = options if x0 is None else checked_options(problem, method, options, options.budget, options.seed, x0)
         result = run_method(problem, method, share, sampler, log, x0=x0)
@@ -160,6 +166,7 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
     t0 = time.perf_counter()
     write_outputs(run)
     timings["report_s"] = time.perf_counter() - t0
+    journal.finish()
     return run
 
 
