@@ -145,6 +145,8 @@ def _handler(server: DashboardServer) -> type[BaseHTTPRequestHandler]:
             try:
                 if url.path == "/":
                     self._send(server.page.encode(), "text/html; charset=utf-8")
+                elif url.path == "/favicon.ico":
+                    self._send(b"", "image/x-icon", cache=True, status=204)
                 elif url.path == "/plotly.min.js":
                     self._send(server.js.read_bytes(), "text/javascript", cache=True)
                 elif url.path == "/api/studies":
