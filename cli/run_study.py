@@ -128,13 +128,7 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
     with SampleStore(store_path) as store, make_executor(workers=workers, scheduler=scheduler) as executor:
         sampler = Sampler(problem, store, executor, progress, retry_failed)
         plan = plan_run(study, options, method, store, executor.workers, retry_failed)
-        opening = [*study_header(study), f"  store {store_path}, {sampler.executor_description}", *plan.text()]
-        for line in opening:
-            log(line)
-        # The journal in the store lets `mechopt dashboard` show the run from the store alone.
-        journal = RunJournal(store_path, sampler.fingerprint, study.name, describe_run(
-            problem, plan, method, opening, out, store.count(sampler.fingerprint)))
-        log = journal.tee(log)
+        journal, log = _announce(study, store, store_path, sampler, plan, method, out, log)
         t0 = time.perf_counter()
         share = options if x0 is None else checked_options(problem, method, options, options.budget, options.seed, x0)
         result = run_method(problem, method, share, sampler, log, x0=x0)
@@ -168,6 +162,18 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
     timings["report_s"] = time.perf_counter() - t0
     journal.finish()
     return run
+
+
+def _announce(study: Study, store: SampleStore, store_path: Path, sampler: Sampler, plan: RunPlan, method: str,
+              out: Path, log: Callable[[str], None]) -> tuple[RunJournal, Callable[[str], None]]:
+    """Print the study and its plan, and start the run's journal in the store (what `mechopt dashboard` reads);
+    the log function returned also records each line there."""
+    opening = [*study_header(study), f"  store {store_path}, {sampler.executor_description}", *plan.text()]
+    for line in opening:
+        log(line)
+    journal = RunJournal(store_path, sampler.fingerprint, study.name,
+                         describe_run(study.problem, plan, method, opening, out, store.count(sampler.fingerprint)))
+    return journal, journal.tee(log)
 
 
 def plan_study(study: Study, options: SparseOptions, workers: int | None = None, scheduler: str | None = None,
