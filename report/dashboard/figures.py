@@ -70,9 +70,11 @@ def parallel_figure(snap: StudySnapshot) -> go.Figure:
         return _empty(title, "no successful simulation yet")
     dims = []
     for j, var in enumerate(snap.variables):
-        dim = {"label": _var_label(var), "values": snap.designs[ok, j]}
+        values = snap.designs[ok, j]
+        dim = {"label": _var_label(var), "values": values}
         if "lower" in var and "upper" in var:
-            dim["range"] = [var["lower"], var["upper"]]
+            # The box, widened to designs sampled outside it (lines run past the bounds to fit the edges).
+            dim["range"] = [min(var["lower"], values.min()), max(var["upper"], values.max())]
         dims.append(dim)
     dims += [{"label": _label(snap, k), "values": snap.values[k][ok]} for k in snap.objectives]
     color = snap.values[snap.objectives[0]][ok]
