@@ -135,7 +135,10 @@ def _progress(data: StudyData, described: dict[str, Any], now: datetime, state: 
             left = remaining * elapsed / done
         elif described.get("expected_s"):
             left = max(0.0, float(described["expected_s"]) - elapsed)
-    return {"records": n, "held": held, "done": done, "planned": planned, "elapsed_s": elapsed, "left_s": left}
+    # How long ago the store last heard of the study: on another host, a killed run reads "running" but goes quiet.
+    quiet = now.timestamp() - max(_seconds(r.timestamp) for r in data.records) if data.records else None
+    return {"records": n, "held": held, "done": done, "planned": planned, "elapsed_s": elapsed, "left_s": left,
+            "quiet_s": quiet}
 
 
 def snapshot(data: StudyData, objective: str | None = None, now: datetime | None = None) -> StudySnapshot:
