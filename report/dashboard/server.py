@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import errno
 import json
+import sqlite3
 import threading
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from importlib.resources import files
@@ -155,8 +156,10 @@ def _handler(server: DashboardServer) -> type[BaseHTTPRequestHandler]:
                     self._send(server.study(query["fp"], query.get("objective")).encode(), "application/json")
                 else:
                     self.send_error(404)
-            except InputError as exc:
-                self._send(json.dumps({"error": str(exc)}).encode(), "application/json", status=503)
+            except (InputError, sqlite3.Error) as exc:
+                # The page says it and asks again at its next refresh (a store being replaced, a locked file).
+                self._send(json.dumps({"error": " ".join(str(exc).split())}).encode(), "application/json",
+                           status=503)
 
         def _send(self, body: bytes, kind: str, cache: bool = False, status: int = 200) -> None:
             self.send_response(status)
