@@ -16,6 +16,7 @@ from collections.abc import Sequence
 from mechopt.cli import (
     catalogue_commands,
     compare_command,
+    dashboard_command,
     region_commands,
     simulate_command,
     study_command,
@@ -65,6 +66,7 @@ def build_parser() -> argparse.ArgumentParser:
     region_commands.add_parsers(sub, ENGINES)
     compare_command.add_parser(sub, ENGINES)
     tolerance_command.add_parser(sub, ENGINES)
+    dashboard_command.add_parser(sub)
     return parser
 
 

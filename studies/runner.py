@@ -29,6 +29,7 @@ from mechopt.optimize.sparse.sampler import Sampler
 from mechopt.optimize.sparse.space import ModelSpace
 from mechopt.optimize.sparse.validate import Validation, validate
 from mechopt.runs.executors import check_reachable, default_workers, make_executor
+from mechopt.runs.run_journal import RunJournal, describe_run
 from mechopt.runs.store import SampleStore
 from mechopt.studies.catalogue import Study
 from mechopt.studies.plan import RunPlan, duration_text, open_store_if_any, plan_run, plan_validation
@@ -128,8 +129,7 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
     with SampleStore(store_path) as store, make_executor(workers=workers, scheduler=scheduler) as executor:
         sampler = Sampler(problem, store, executor, progress, retry_failed)
         plan = plan_run(study, options, method, store, executor.workers, retry_failed)
-        for line in [*study_header(study), f"  store {store_path}, {sampler.executor_description}", *plan.text()]:
-            log(line)
+        journal, log = _announce(study, store, store_path, sampler, plan, method, out, log)
         t0 = time.perf_counter()
         share = options if x0 is None else checked_options(problem, method, options, options.budget, options.seed, x0)
         result = run_method(problem, method, share, sampler, log, x0=x0)
@@ -162,7 +162,20 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
     t0 = time.perf_counter()
     write_outputs(run)
     timings["report_s"] = time.perf_counter() - t0
+    journal.finish()
     return run
+
+
+def _announce(study: Study, store: SampleStore, store_path: Path, sampler: Sampler, plan: RunPlan, method: str,
+              out: Path, log: Callable[[str], None]) -> tuple[RunJournal, Callable[[str], None]]:
+    """Print the study and its plan, and start the run's journal in the store (what `mechopt dashboard` reads);
+    the log function returned also records each line there."""
+    opening = [*study_header(study), f"  store {store_path}, {sampler.executor_description}", *plan.text()]
+    for line in opening:
+        log(line)
+    journal = RunJournal(store_path, sampler.fingerprint, study.name,
+                         describe_run(study.problem, plan, method, opening, out, store.count(sampler.fingerprint)))
+    return journal, journal.tee(log)
 
 
 def plan_study(study: Study, options: SparseOptions, workers: int | None = None, scheduler: str | None = None,
