@@ -110,5 +110,6 @@ def _closest(problem: DesignProblem, X: np.ndarray, F: np.ndarray, V: np.ndarray
         message += ", " + ", ".join(f"{n} = {outputs[order[0]].get(n, float('nan')):.4g}" for n in limits.names)
     message += ")"
     if spec.k == 1:
-        return {**base, "x": X[order[0]].copy(), "fun": float(F[order[0], 0]), "message": message}
+        return {**base, "x": X[order[0]].copy(), "fun": float(F[order[0], 0]), "message": message,
+                "outputs": base["front_outputs"][0]}
     return {**base, "x": X[order].copy(), "fun": F[order].copy(), "message": message}

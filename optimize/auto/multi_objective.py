@@ -29,7 +29,6 @@ from mechopt.optimize.auto.feasibility import SuccessModel
 from mechopt.optimize.auto.gp import GaussianProcess, fit_gp
 from mechopt.optimize.auto.limit_models import LimitModels
 from mechopt.optimize.auto.search import _limited_threads
-from mechopt.optimize.auto.transform import standardise
 
 __all__ = ["TradeOffRun", "initial_size", "trade_off_search"]
 
@@ -132,7 +131,9 @@ class _Scalarised:
         full = self.theta is None or U.shape[0] >= 1.25 * self.fitted_n
         if full:
             self.fitted_n = U.shape[0]
-        y = standardise(s, compress_tail=False)
+        # The scalarisation of [0, 1] objectives has no long tail to compress: a z-score (the Yeo-Johnson fit of
+        # the global model cost 40 ms a proposal).
+        y = (s - s.mean()) / (float(np.std(s)) or 1.0)
         gp = fit_gp(U, y, rng, warm=self.theta, starts=3 if full else 1, maxiter=100 if full else 30, prior=False,
                     spacing_floor=True)
         self.theta = gp.theta
