@@ -67,21 +67,21 @@ def front_mask(F: np.ndarray) -> np.ndarray:
 
 
 def normalisation(front: np.ndarray, ideal: np.ndarray | None = None,
-                  reference_point: np.ndarray | None = None) -> Normalisation:
+                  nadir: np.ndarray | None = None) -> Normalisation:
     """The normalisation of :mod:`this module <mechopt.optimize.pareto>` for a front (n, k) of minimised values.
 
     Parameters
     ----------
     front : (n, k) ndarray
         Non-dominated values (at least one row unless both other arguments are given).
-    ideal, reference_point : (k,) ndarray, optional
-        Fixed by the problem: both, or neither.
+    ideal, nadir : (k,) ndarray, optional
+        Fixed by the problem (its known front): both, or neither.
     """
-    if ideal is not None and reference_point is not None:
-        ideal, ref = np.asarray(ideal, float), np.asarray(reference_point, float)
-        return Normalisation(ideal, np.maximum(ref - ideal, 1e-300), np.ones(ideal.size),
-                             f"z = (f - ideal) / (reference - ideal) with ideal {_fmt(ideal)} and reference "
-                             f"{_fmt(ref)} fixed by the problem; reference point z = 1")
+    if ideal is not None and nadir is not None:
+        ideal, nadir = np.asarray(ideal, float), np.asarray(nadir, float)
+        return Normalisation(ideal, np.maximum(nadir - ideal, 1e-300), np.full(ideal.size, REFERENCE_MARGIN),
+                             f"z = (f - ideal) / (nadir - ideal) with the problem's ideal {_fmt(ideal)} and nadir "
+                             f"{_fmt(nadir)}; reference point z = {REFERENCE_MARGIN:g} in every objective")
     front = np.atleast_2d(front)
     lo, hi = front.min(axis=0), front.max(axis=0)
     span = np.where(hi > lo, hi - lo, np.maximum(np.abs(lo), 1.0))

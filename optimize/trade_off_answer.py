@@ -80,7 +80,7 @@ def trade_off_answer(problem: DesignProblem, X: np.ndarray, F: np.ndarray, G: np
                            f"{limits.describe() or 'the margins'}"}
     front = idx[front_mask(F[idx])]
     front = front[np.argsort(F[front, 0], kind="stable")]
-    norm = normalisation(F[front], getattr(problem, "ideal", None), getattr(problem, "reference_point", None))
+    norm = normalisation(F[front], getattr(problem, "ideal", None), getattr(problem, "nadir", None))
     hv = hypervolume(F[front], norm)
     return {"x": X[front].copy(), "fun": F[front].copy(), "success": True, "feasible": np.ones(front.size, bool),
             "front_outputs": [dict(outputs[i] or {}) for i in front], "front_index": front,
