@@ -83,7 +83,8 @@ def table(rows: list[dict]) -> str:
     for r in rows:
         cells.setdefault((r["problem"], r["budget"], r["method"]), []).append(r)
     methods = [m for m in METHODS if any(key[2] == m for key in cells)]
-    head = "| problem | budget | " + " | ".join(methods) + " | auto >= every peer | auto method s/sim |"
+    head = ("| problem | budget | " + " | ".join(methods)
+            + " | auto >= every peer | auto s/sim (method wall; CPU of the whole run) |")
     lines = [head, "|" + "---|" * (len(methods) + 4)]
     for prob, budget in sorted({(k[0], k[1]) for k in cells}, key=lambda t: (t[1], t[0])):
         med = {}
@@ -99,8 +100,9 @@ def table(rows: list[dict]) -> str:
         auto_rs = cells.get((prob, budget, "auto"), [])
         beats = "-" if "auto" not in med else ("yes" if all(med["auto"] >= v for v in med.values()) else "no")
         per_sim = (statistics.median(r.get("method_s", math.nan) / budget for r in auto_rs) if auto_rs else math.nan)
+        cpu = statistics.median(r["cpu_s"] / budget for r in auto_rs) if auto_rs else math.nan
         broken = sum(r.get("broken", 0) for r in auto_rs)
-        lines.append(f"| {prob} | {budget} | " + " | ".join(texts) + f" | {beats} | {per_sim:.3f}"
+        lines.append(f"| {prob} | {budget} | " + " | ".join(texts) + f" | {beats} | {per_sim:.3f}; {cpu:.3f}"
                      + (f", {broken} broken" if broken else "") + " |")
     return "\n".join(lines)
 
