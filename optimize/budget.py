@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import OptimizeResult
 
+from mechopt.errors import InputError
 from mechopt.optimize.constrained_box import ConstrainedBox
 
 __all__ = ["BudgetExhausted", "CountedProblem", "Evaluation", "run_multistart"]
@@ -103,7 +104,7 @@ class CountedProblem(ConstrainedBox):
     ) -> None:
         super().__init__(bounds, constraints, vectorized_constraints=vectorized_constraints)
         if int(budget) != budget or budget < 0:
-            raise ValueError(f"budget must be a non-negative integer, got {budget!r}")
+            raise InputError(f"budget must be a non-negative integer, got {budget!r}")
         self._objective = objective
         self.budget = int(budget)
         self.penalty = float(penalty)
@@ -177,7 +178,7 @@ class CountedProblem(ConstrainedBox):
             f = float(self._objective(x.copy()))
         except self.failure_errors:
             f = math.nan
-        feasible = self.feasible(x)
+        feasible = bool(self.feasible(x)[0])
         self.history.append(Evaluation(x, f, feasible))
         if feasible and math.isfinite(f) and f < self.best_f:
             self.best_f, self.best_x = f, x.copy()
@@ -209,9 +210,9 @@ class CountedProblem(ConstrainedBox):
             NaN when the simulation failed or no continuation is possible (infeasible ``x`` without anchor).
         """
         x = np.asarray(x, dtype=float)
-        if self.simulate_infeasible or self.feasible(x):
+        if self.simulate_infeasible or self.feasible(x)[0]:
             return self.evaluate(x)
-        if anchor is None or not self.feasible(anchor):
+        if anchor is None or not self.feasible(anchor)[0]:
             return math.nan
         anchor = np.asarray(anchor, dtype=float)
         p = self.boundary_point(anchor, x)

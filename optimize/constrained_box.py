@@ -1,9 +1,13 @@
 """The design space of a black-box problem: a box of design variables and cheap constraint margins.
 
 Everything here is cheap (kinematics, no simulation) and is not counted against any budget: mapping designs to and
-from the unit cube, constraint margins and violation, feasibility of one design or of a batch, feasible
-Latin-hypercube samples and the last feasible point of a segment.  :class:`~mechopt.optimize.budget.CountedProblem`
-adds the expensive, counted objective on top.
+from the unit cube, constraint margins and violation, feasibility of a batch of designs, feasible Latin-hypercube
+samples and the last feasible point of a segment.  :class:`~mechopt.optimize.budget.CountedProblem` adds the
+expensive, counted objective on top.
+
+Feasibility is :meth:`DesignProblem.feasible <mechopt.optimize.problem.DesignProblem.feasible>` itself, on the box
+and margins seen as a design problem (:class:`BoxProblem`): one vectorised test, ``(n, d) -> (n,)`` booleans, with
+the same meaning wherever a design is checked.
 """
 
 from __future__ import annotations
@@ -13,7 +17,78 @@ from collections.abc import Callable, Sequence
 import numpy as np
 from scipy.stats import qmc
 
-__all__ = ["ConstrainedBox"]
+from mechopt.errors import InputError
+from mechopt.optimize.problem import DesignProblem, Variable
+
+__all__ = ["BoxProblem", "ConstrainedBox", "checked_bounds"]
+
+MarginFunction = Callable[[np.ndarray], np.ndarray]
+
+
+def checked_bounds(bounds: Sequence[Sequence[float]] | np.ndarray) -> np.ndarray:
+    """A box as a float array of shape (d, 2), finite, with low < high in every row.
+
+    Raises
+    ------
+    InputError
+        One line naming what is wrong with ``bounds``.
+    """
+    try:
+        box = np.asarray(bounds, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"bounds must be numbers, got {bounds!r:.80}") from None
+    if box.ndim != 2 or box.shape[1] != 2 or box.shape[0] < 1:
+        raise InputError(f"bounds must have shape (d, 2), got {box.shape}")
+    if not np.all(np.isfinite(box)) or np.any(box[:, 1] <= box[:, 0]):
+        raise InputError(f"bounds must be finite with low < high, got {box.tolist()}")
+    return box
+
+
+class BoxProblem(DesignProblem):
+    """A box and a margins function as a :class:`~mechopt.optimize.problem.DesignProblem` (variables ``x0``,
+    ``x1``, ..., constraints ``g0``, ``g1``, ...), for its feasibility test.
+
+    Parameters
+    ----------
+    bounds : sequence of (low, high) pairs or array of shape (d, 2)
+        Box of the design space, in the variables' units.
+    constraints : callable, optional
+        ``constraints(x) -> array`` of margins, feasible when all are ``>= 0``.
+    vectorized_constraints : bool, default False
+        ``constraints`` accepts an array ``(n, d)`` and returns ``(n, m)``; otherwise it is called design by design.
+
+    Notes
+    -----
+    The number of margins is learned from one call at the box's centre the first time it is needed.
+    """
+
+    name = "box"
+
+    def __init__(self, bounds: Sequence[Sequence[float]] | np.ndarray, constraints: MarginFunction | None = None, *,
+                 vectorized_constraints: bool = False) -> None:
+        box = checked_bounds(bounds)
+        self.variables = tuple(Variable(f"x{i}", float(lo), float(hi)) for i, (lo, hi) in enumerate(box))
+        self._function = constraints
+        self._vectorized = bool(vectorized_constraints)
+        self._names: tuple[str, ...] | None = None if constraints is not None else ()
+
+    @property
+    def constraints(self) -> tuple[str, ...]:  # type: ignore[override]
+        """``g0``, ``g1``, ... one name a margin."""
+        if self._names is None:
+            count = self.margins(self.bounds.mean(axis=1)[None, :]).shape[1]
+            self._names = tuple(f"g{j}" for j in range(count))
+        return self._names
+
+    def margins(self, X: np.ndarray) -> np.ndarray:
+        """Margins of designs X (n, d), shape (n, m); NaN where the function gave NaN."""
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        if self._function is None:
+            return np.zeros((X.shape[0], 0))
+        if self._vectorized:
+            return np.asarray(self._function(X), dtype=float).reshape(X.shape[0], -1)
+        rows = [np.atleast_1d(np.asarray(self._function(x), dtype=float)).ravel() for x in X]
+        return np.array(rows, dtype=float).reshape(X.shape[0], -1)
 
 
 class ConstrainedBox:
@@ -28,9 +103,14 @@ class ConstrainedBox:
     vectorized_constraints : bool, default False
         ``constraints`` accepts an array ``(n, d)`` and returns ``(n, m)``; speeds up dense feasibility checks.
 
+    Attributes
+    ----------
+    space : BoxProblem
+        The box and margins as a design problem: its :meth:`~BoxProblem.feasible` is the feasibility test.
+
     Raises
     ------
-    ValueError
+    InputError
         If ``bounds`` is not of shape (d, 2), finite, with low < high.
     """
 
@@ -41,11 +121,8 @@ class ConstrainedBox:
         *,
         vectorized_constraints: bool = False,
     ) -> None:
-        box = np.asarray(bounds, dtype=float)
-        if box.ndim != 2 or box.shape[1] != 2 or box.shape[0] < 1:
-            raise ValueError(f"bounds must have shape (d, 2), got {box.shape}")
-        if not np.all(np.isfinite(box)) or np.any(box[:, 1] <= box[:, 0]):
-            raise ValueError("bounds must be finite with low < high")
+        box = checked_bounds(bounds)
+        self.space = BoxProblem(box, constraints, vectorized_constraints=vectorized_constraints)
         self._constraints = constraints
         self.lower = box[:, 0].copy()
         self.upper = box[:, 1].copy()
@@ -122,43 +199,27 @@ class ConstrainedBox:
         box = np.sum(np.maximum(self.lower - x, 0.0)) + np.sum(np.maximum(x - self.upper, 0.0))
         return float(box + np.sum(np.maximum(-self.margins(x), 0.0)))
 
-    def feasible(self, x: np.ndarray) -> bool:
-        """Whether a design lies in the box and satisfies every constraint margin.
+    def feasible(self, X: np.ndarray) -> np.ndarray:
+        """Which designs lie in the box and satisfy every constraint margin (NaN margins count as violated).
 
         Parameters
         ----------
-        x : ndarray, shape (d,)
-
-        Returns
-        -------
-        bool
-        """
-        x = np.asarray(x, dtype=float)
-        if np.any(x < self.lower) or np.any(x > self.upper):
-            return False
-        return self._constraints is None or bool(np.all(self.margins(x) >= 0.0))
-
-    def feasible_many(self, X: np.ndarray) -> np.ndarray:
-        """Feasibility of a batch of designs.
-
-        Parameters
-        ----------
-        X : ndarray, shape (n, d)
+        X : ndarray, shape (n, d) or (d,)
+            Designs (one design is a batch of one).
 
         Returns
         -------
         ndarray of bool, shape (n,)
+            :meth:`DesignProblem.feasible <mechopt.optimize.problem.DesignProblem.feasible>` of :attr:`space`; a
+            design with a non-finite coordinate (a method's failed step) is infeasible.
         """
-        X = np.atleast_2d(np.asarray(X, dtype=float))
-        inside = np.all((X >= self.lower) & (X <= self.upper), axis=1)
-        if self._constraints is None or X.shape[0] == 0:
-            return inside
-        if self.vectorized_constraints:
-            g = np.asarray(self._constraints(X), dtype=float).reshape(X.shape[0], -1)
-            return inside & np.all(g >= 0.0, axis=1)  # NaN >= 0 is False, as wanted
-        ok = inside.copy()
-        for i in np.flatnonzero(inside):
-            ok[i] = bool(np.all(self.margins(X[i]) >= 0.0))
+        X = np.array(X, dtype=float, ndmin=2)
+        finite = np.all(np.isfinite(X), axis=1)
+        if finite.all():
+            return self.space.feasible(X)
+        ok = np.zeros(X.shape[0], dtype=bool)
+        if finite.any():
+            ok[finite] = self.space.feasible(X[finite])
         return ok
 
     def sample_feasible(self, n: int, rng: np.random.Generator, *, max_batches: int = 50) -> np.ndarray:
@@ -185,7 +246,7 @@ class ConstrainedBox:
         batch = max(n, 16)
         for _ in range(max_batches):
             X = self.from_unit(qmc.LatinHypercube(self.dim, rng=rng).random(batch))
-            good = X[self.feasible_many(X)]
+            good = X[self.feasible(X)]
             found.append(good)
             total += good.shape[0]
             if total >= n:
@@ -214,7 +275,7 @@ class ConstrainedBox:
         lo, hi = 0.0, 1.0
         for _ in range(n_bisect):
             mid = 0.5 * (lo + hi)
-            if self.feasible(inside + mid * (outside - inside)):
+            if self.feasible(inside + mid * (outside - inside))[0]:
                 lo = mid
             else:
                 hi = mid

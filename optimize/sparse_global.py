@@ -1,4 +1,4 @@
-"""The sparse line model made global on multimodal landscapes (issue 15).
+"""The sparse line model made global on multimodal landscapes.
 
 Paper 002's method — samples on l parallel lines, a sum of exponentials per line, a Chebyshev blend across the lines,
 an exhaustive search of the blend — resolves only features wider than the line spacing: between lines the blend
@@ -16,9 +16,8 @@ strategy here keeps the method and stops trusting the model's single answer:
    simulated design that cycles from a fifth of the box to none, one simulation a step.  Where the blend was wrong
    between its lines, the step after one simulation there knows it; where nothing was simulated, the blend's shape
    still guides.  The last ``exploit_share`` of the budget steps at the corrected model's own minimum and takes the
-   best basin to its bottom.  (Measured against the earlier zooms and finite-difference local searches: at 60
-   evaluations Hartmann-3 within 0.5 % of its range in 10 seeds of 10 instead of 8, the cosine function in 8 instead
-   of 0, Himmelblau's disc in 10 instead of 4; ``benchmarks/bench_multimodal.py``.)
+   best basin to its bottom.  Local line plans (zooms) and finite-difference local searches in their place end
+   more runs in a wrong basin (``docs/guide/design-evidence.md``).
 4. The best SIMULATED design is the answer; the model never reports a value of its own.  A trust report gives the
    leave-one-line-out error of the global blend relative to the sampled range, how far the model's own claim was
    from the simulation, and which step produced the winner.
@@ -30,7 +29,6 @@ batch evaluator ``evaluate(X (n, d)) -> (n,)``, so a caller can put a store or a
 from __future__ import annotations
 
 import math
-import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -38,26 +36,19 @@ from typing import Any
 import numpy as np
 
 from mechopt.errors import InputError
+from mechopt.optimize.sparse.global_lines import MIN_RUN, FittedLines, blend_basins, line_stage
 from mechopt.optimize.sparse.model_confidence import RESOLVED
 from mechopt.optimize.sparse.model_exploration import DISTANCE_CYCLE, explore
-from mechopt.surrogate import LinePlan, SparseExponentialModel, SurrogateError, exhaustive_search, plan_lines
-from mechopt.surrogate.basins import Minima, field_minima, thin
-from mechopt.surrogate.errors import SurrogateWarning
-from mechopt.surrogate.line_error import LineOutError, blend_spread, leave_one_line_out
+from mechopt.surrogate import SparseExponentialModel
+from mechopt.surrogate.basins import Minima, thin
 
 __all__ = ["GlobalSearchResult", "global_search"]
 
 Predicate = Callable[[np.ndarray], np.ndarray]
 BatchEvaluator = Callable[[np.ndarray], np.ndarray]
 
-#: Grid points per axis of the basin search (d = 2, 3, 4).
-_GRID = {2: 121, 3: 33, 4: 15}
-#: Grid points of the exhaustive search of a blend (paper 002: 10 million for its single model).
-_SEARCH_POINTS = {2: 40_000, 3: 200_000, 4: 400_000}
 #: Fewest lines of a plan, per dimension (the blend needs more nodes than its normal plane has dimensions).
 _MIN_LINES = {2: 3, 3: 4, 4: 5}
-#: Fewest samples a line keeps (a sum of exponentials of order 1 with a constant needs 4).
-_MIN_RUN = 4
 
 
 @dataclass
@@ -168,127 +159,6 @@ class _Counted:
         return self.Z[j], float(f[j]), self.source[j]
 
 
-@dataclass
-class _Fitted:
-    """A line model fitted to its samples (unit-cube coordinates)."""
-
-    model: SparseExponentialModel
-    values: list[np.ndarray]
-    lolo: LineOutError | None
-
-
-def _trim(plan: LinePlan, max_samples: int) -> LinePlan:
-    """Shorten the lines about their middles, in proportion, until the plan asks for at most ``max_samples``."""
-    kr = np.asarray(plan.k_ranges)
-    counts = kr[:, 1] - kr[:, 0] + 1
-    if counts.sum() <= max_samples:
-        return plan
-    keep = np.maximum(_MIN_RUN, np.floor(counts * max_samples / counts.sum()).astype(int))
-    while keep.sum() > max_samples and keep.max() > _MIN_RUN:
-        keep[np.argmax(keep)] -= 1
-    start = kr[:, 0] + (counts - keep) // 2
-    return plan.with_k_ranges(np.column_stack([start, start + keep - 1]))
-
-
-def _longest_finite_run(values: np.ndarray) -> slice:
-    ok = np.concatenate(([False], np.isfinite(values), [False])).astype(np.int8)
-    edges = np.flatnonzero(np.diff(ok))
-    if edges.size == 0:
-        return slice(0, 0)
-    starts, stops = edges[0::2], edges[1::2]
-    j = int(np.argmax(stops - starts))
-    return slice(int(starts[j]), int(stops[j]))
-
-
-def _box_predicate(lo: np.ndarray, hi: np.ndarray, inner: Predicate) -> Predicate:
-    def pred(Z: np.ndarray) -> np.ndarray:
-        Z = np.atleast_2d(Z)
-        ok = np.all((Z >= lo - 1e-12) & (Z <= hi + 1e-12), axis=1)
-        if ok.any():
-            ok[ok] = np.asarray(inner(Z[ok]), dtype=bool).reshape(-1)
-        return ok
-    return pred
-
-
-def _line_stage(counted: _Counted, lo: np.ndarray, hi: np.ndarray, feasible: Predicate, sampleable: Predicate,
-                n_lines: int, samples_per_line: int, max_samples: int, fit: str, max_order: int, seed: int,
-                source: str) -> _Fitted | None:
-    """Plan lines over [lo, hi] ∩ feasible, sample them (capped), fit and blend; None if no plan or fit exists."""
-    min_samples = min(samples_per_line, max(_MIN_RUN, samples_per_line // 2))
-    res = None
-    for attempt in range(3):  # a plan may fail for an odd seed or a thin region: two more seeds, nothing spent yet
-        try:
-            res = plan_lines(lo, hi, feasible, n_lines=n_lines, samples_per_line=samples_per_line,
-                             min_samples=min_samples, n_probe=4000, n_random=4, n_refine=8, seed=seed + 1000 * attempt,
-                             sampleable=sampleable, layout="fekete")
-            break
-        except SurrogateError:
-            continue
-    if res is None:
-        return None
-    plan = _trim(res.plan, max_samples)
-    designs = [plan.points(i, np.arange(k0, k1 + 1)) for i, (k0, k1) in enumerate(plan.k_ranges)]
-    values = counted(np.vstack(designs), source)
-    samples, kept, k_ranges, start = [], [], [], 0
-    for i, D in enumerate(designs):
-        v = values[start : start + len(D)]
-        start += len(D)
-        run = _longest_finite_run(v)  # a failed evaluation splits a line: fit its longest clean stretch
-        ks = np.arange(plan.k_ranges[i][0], plan.k_ranges[i][1] + 1)[run]
-        v = v[run]
-        if v.size < 4:
-            return None
-        if fit == "square" and np.any(v < 0):
-            raise InputError(f"fit='square' needs a non-negative objective, got {v.min():.4g} on a line")
-        samples.append((ks, v * v if fit == "square" else v))
-        kept.append(v * v if fit == "square" else v)
-        k_ranges.append([int(ks[0]), int(ks[-1])])
-    plan = plan.with_k_ranges(np.array(k_ranges))
-    order_cap = max(1, min(max_order, (min(len(v) for v in kept) - 1) // 2))
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", SurrogateWarning)
-            model = SparseExponentialModel(max_order=order_cap).fit(plan, samples)
-    except SurrogateError:
-        return None
-    try:
-        lolo = leave_one_line_out(model, kept) if model.l >= 3 else None
-    except SurrogateError:
-        lolo = None
-    return _Fitted(model, kept, lolo)
-
-
-def _basins(fitted: _Fitted, lo: np.ndarray, hi: np.ndarray, feasible: Predicate, kappa: float, n_model: int,
-            n_bound: int, radius: float) -> tuple[Minima, Minima]:
-    """Distinct minima of the blend and of ``blend − κ·spread`` over the grid of [lo, hi] ∩ hull ∩ feasible."""
-    model = fitted.model
-    hull = model.hull
-
-    def region(Z: np.ndarray) -> np.ndarray:
-        ok = hull.contains(Z)
-        if ok.any():
-            ok[ok] = np.asarray(feasible(Z[ok]), dtype=bool).reshape(-1)
-        return ok
-
-    n = _GRID[lo.size]
-    by_model = field_minima(lambda Z: model.predict(Z), lo, hi, region, n, radius, n_model)
-    # The paper's own answer, the exhaustive search of the blend (finer grid, polished), leads the model's minima.
-    found = exhaustive_search(model, feasible=lambda Z: feasible(Z) & _box_predicate(lo, hi, feasible)(Z),
-                              n_points=_SEARCH_POINTS[lo.size])
-    if found.success:
-        by_model = thin(np.vstack([found.x[None, :], by_model.x]), np.concatenate([[found.fun], by_model.value]),
-                        radius, n_model)
-    if kappa > 0 and n_bound > 0 and model.l >= 4:
-        try:
-            by_bound = field_minima(lambda Z: model.predict(Z) - kappa * blend_spread(model, Z), lo, hi, region, n,
-                                    radius, n_bound)
-        except SurrogateError:
-            by_bound = Minima(np.zeros((0, lo.size)), np.zeros(0))
-    else:
-        by_bound = Minima(np.zeros((0, lo.size)), np.zeros(0))
-    return by_model, by_bound
-
-
 def _as_objective(fit: str, value: np.ndarray) -> np.ndarray:
     value = np.asarray(value, dtype=float)
     return np.sqrt(np.maximum(value, 0.0)) if fit == "square" else value
@@ -351,7 +221,7 @@ def global_search(evaluate: BatchEvaluator, bounds: Any, feasible: Predicate, sa
         Take the steps on the corrected blend (False: the lines and the blend's basins only, what the line model
         alone finds; the rest of the budget is not spent).
     batch : int
-        Designs evaluated at once (issue 28): steps on the corrected blend, and more basins; 1 (default): as ever.
+        Designs evaluated at once: steps on the corrected blend, and more basins; 1 (default): as ever.
 
     Returns
     -------
@@ -364,7 +234,7 @@ def global_search(evaluate: BatchEvaluator, bounds: Any, feasible: Predicate, sa
     """
     b = _checked_bounds(bounds, fit, budget, global_share, exploit_share, cycle)
     if n_candidates is None:
-        # The basins are one round whatever their number: free workers simulate more of them (issue 28).
+        # The basins are one round whatever their number: free workers simulate more of them.
         n_candidates = max(int(np.clip(budget // 40, 1, 4)), min(4, math.ceil(batch / 2)))
     run = _GlobalRun(evaluate, b, feasible, feasible if sampleable is None else sampleable, budget, fit)
     glob = run.global_stage(global_share, samples_per_line, n_lines, max_order, seed, kappa, n_candidates,
@@ -425,15 +295,15 @@ class _GlobalRun:
         return lambda Z: np.asarray(pred(lower + np.atleast_2d(Z) * width), dtype=bool).reshape(-1)
 
     def global_stage(self, global_share: float, samples_per_line: int, n_lines: int | None, max_order: int, seed: int,
-                     kappa: float, n_candidates: int, basin_radius: float) -> _Fitted | None:
+                     kappa: float, n_candidates: int, basin_radius: float) -> FittedLines | None:
         """Steps 1 and 2: the global lines sampled and blended, then every distinct minimum of the blend and of its
         optimistic bound simulated.  None when no line plan or fit exists."""
         counted, dim = self.counted, self.dim
         n_global = int(round(global_share * self.budget))
         l_global = n_lines or max(_MIN_LINES[dim], n_global // samples_per_line)
-        n_global = max(n_global, _MIN_RUN * l_global)
+        n_global = max(n_global, MIN_RUN * l_global)
         zero, one = np.zeros(dim), np.ones(dim)
-        glob = _line_stage(counted, zero, one, self.feas_z, self.samp_z, l_global, samples_per_line, n_global,
+        glob = line_stage(counted, zero, one, self.feas_z, self.samp_z, l_global, samples_per_line, n_global,
                            self.fit, max_order, seed, "global lines")
         if glob is None:
             self.stages.append({"name": "global", "lines": 0, "nfev": counted.nfev, "message": "no line plan fits"})
@@ -441,7 +311,7 @@ class _GlobalRun:
         self.models["global"] = glob.model
         if glob.lolo is not None:
             self.trust["lolo_median"], self.trust["lolo_max"] = glob.lolo.median, glob.lolo.max
-        by_model, by_bound = _basins(glob, zero, one, self.feas_z, kappa, n_candidates, n_candidates, basin_radius)
+        by_model, by_bound = blend_basins(glob, zero, one, self.feas_z, kappa, n_candidates, n_candidates, basin_radius)
         first = len(self.cand_z)
         self.simulate_candidates([by_model, by_bound], glob.model, "global model")
         self.stages.append({"name": "global", "lines": glob.model.l, "nfev": counted.nfev,
@@ -476,7 +346,7 @@ class _GlobalRun:
         if j is not None and sampled_range > 0 and math.isfinite(self.cand_f[j]):
             self.trust["claim_error"] = abs(self.cand_pred[j] - self.cand_f[j]) / sampled_range
 
-    def corrected_steps(self, glob: _Fitted | None, exploit_share: float, seed: int, cycle: tuple[float, ...],
+    def corrected_steps(self, glob: FittedLines | None, exploit_share: float, seed: int, cycle: tuple[float, ...],
                         margins: Callable[[np.ndarray], np.ndarray] | None, batch: int = 1) -> None:
         """Step 3: steps on the blend corrected by every simulation, first cycling through distances from the
         simulated designs (unseen regions, then closer), then at the corrected model's own minimum."""

@@ -5,8 +5,8 @@ simulator function defined in it is pickled by reference).  The fork server is m
 worker from that, but CPython 3.11 never hands it the script's path (``ForkServer.ensure_running`` keeps the keys
 ``main_path`` and ``sys_path`` of preparation data that names it ``init_main_from_path``), so each worker imported it
 anew: with a script that imports mechopt's optimizers, 1.5 s of CPU per worker, 14 s before the first simulation on 8
-workers on 2 cores (issue 28).  The parent puts the script's path (or module name) in an environment variable before
-the server starts (:func:`mechopt.runs.executors._mp_context`); importing this module in the server imports it, as
+workers on 2 cores.  The parent puts the script's path (or module name) in an environment variable before
+the server starts (:func:`mechopt.runs.worker_processes.mp_context`); importing this module in the server imports it, as
 the server would with the path, and each worker forked from there finds it already loaded.
 """
 

@@ -11,7 +11,7 @@ descent on the function itself (L-BFGS-B in the box, SLSQP when there are constr
 of the ``x_min``.  ``gap`` is (f(x) − f_min) / f_range, the measure of the benchmarks.
 
 References: Dixon & Szegő (1978) for Hartmann-3, Branin and the six-hump camel; Himmelblau (1972); the cosine
-function is issue 15's (a quadratic bowl with a product of cosines, 31 local minima in [0, 1]^3).
+function is mechopt's own (a quadratic bowl with a product of cosines, 31 local minima in [0, 1]^3).
 """
 
 from __future__ import annotations

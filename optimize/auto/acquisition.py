@@ -121,12 +121,9 @@ def propose_batch(gp: GaussianProcess, best: float, lo: np.ndarray, hi: np.ndarr
 
     A believed design is data: the incumbent becomes the least of it, and the believed value is exact
     (:meth:`GaussianProcess.believe`).  With the incumbent left at the simulated designs' least, a design the model
-    expects below it kept its expected improvement for its neighbours, and up to 6 designs of a batch of 8 went
-    within 1e-3 of each other (Hartmann-6, 60 simulations).  The two changes together, measured *ad hoc*
-    (``auto_search`` at 60 simulations, seeds 0-19, median gap % of the range and runs within 0.5 %, before ->
-    after), batches of 4: cosine_bowl4 0.35 (10) -> 0.001 (17), Hartmann-6 0.31 (11) -> 0.005 (15), cosine_bowl3
-    0.0007 (18) -> 0.0004 (20); batches of 8: cosine_bowl4 0.18 (11) -> 0.08 (13), Styblinski-Tang-3 0.0003 (17) ->
-    0.0001 (20), Hartmann-6 3.8 (5) -> 3.7 (6); Hartmann-3 all 20 either way.
+    expects below it would keep its expected improvement for its neighbours, and the designs of a batch would crowd
+    together (up to 6 of 8 within 1e-3 of each other on Hartmann-6; the measurements:
+    ``docs/guide/design-evidence.md``).
 
     Parameters
     ----------

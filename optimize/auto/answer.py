@@ -7,19 +7,14 @@ out most negative, and its design is a lucky draw more than a good one.  The GP 
 noise (its white-noise variance, by the same marginal likelihood as the length-scales) and its posterior mean at a
 simulated design is the objective smoothed over its neighbours; the design of lowest mean is the better answer
 (the in-sample "best point" of noisy Bayesian optimisation: Letham, Karrer, Ottoni & Bakshy 2019; BoTorch and Ax
-report it).  Measured *ad hoc* (``auto_search``, noise a deterministic hash of the design, gap of the noise-free
-function at the answer, % of the range): Hartmann-3 at 30 simulations with noise of 5 % of the range, 10 seeds,
-median 1.25 -> 0.66 %; Hartmann-6 at 300 with noise of 1 %, 5 seeds, 0.571 -> 0.077 %.
+report it).  The measurements behind this module's choices: ``docs/guide/design-evidence.md``.
 
 A deterministic simulator keeps the lowest value simulated as its answer.  Mostly its fitted noise sits at the
 numerical floor, and the mean at a design is its value.  Where the kernel fits the function imperfectly the fit may
 buy a little noise (cosine_bowl3 at 30 simulations, seed 5: a noise sd of 0.6 % of the values', and an answer
 0.011 % of the range above the lowest value), so the noise must also earn its place: the evidence for it against
 the near-interpolating model (a noise variance of ``NOISE_THRESHOLD``, every other hyperparameter fitted again)
-must be strong, a Bayes factor above e^3 ≈ 20 (2 ln B > 6, Kass & Raftery 1995).  Measured *ad hoc* at the end of
-``auto_search`` runs, ln B: cosine_bowl3's seed 5 −5.8 (the near-interpolating model is the better one); Hartmann-3
-at 30 with noise of 0.1 %, 1 % and 5 % of the range, 10 seeds each, 0.4-37, 12-38 and 1.6-23 (the two runs under 3
-at 0.1 % and the two at 5 % keep their lowest value).
+must be strong, a Bayes factor above e^3 ≈ 20 (2 ln B > 6, Kass & Raftery 1995).
 """
 
 from __future__ import annotations

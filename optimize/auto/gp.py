@@ -8,11 +8,8 @@ variance between the two components.  Where the objective is a sum of one contri
 a sum of terms, a separable well in each variable), the model then predicts a combination of the variables no
 design has from what each variable did elsewhere: a variable left in the wrong one of its wells is seen to be
 wrong.  The product kernel alone cannot, and expects nothing from a move it has not sampled near.  Where the
-variables interact, the evidence gives the additive component (nearly) nothing, and the model is the product's.
-Measured with ``benchmarks/bench_default.py`` (20 seeds; BENCHMARKS.md), median gap at 30 simulations before ->
-after: Styblinski-Tang-3 3.3 -> 0.099 % (the global well in 16 seeds instead of 6), Hartmann-4 0.37 -> 0.064 %,
-cosine_bowl4 9.8 -> 7.7 %, Hartmann-3 0.0020 -> 0.00067 %; cosine_bowl3 0.044 -> 0.81 % (its global basin in 11
-seeds instead of 15: a bowl, additive, under a product of cosines, which is not).  A component the evidence gives
+variables interact, the evidence gives the additive component (nearly) nothing, and the model is the product's
+(the measurements: ``docs/guide/design-evidence.md``).  A component the evidence gives
 under 1e-3 of the product's variance is left out of the fitted model, which then costs what the product alone does.
 
 The hyperparameters are fitted under a constant prior mean, estimated by generalised least squares (ordinary
@@ -23,11 +20,7 @@ function's level: a minimiser piles its designs into the low basins, so the aver
 model expects wherever it has not looked; every unexplored corner then seems promising.  Generalised least squares
 weighs a cluster of correlated designs about as one.  The level's own uncertainty is left out of the variance, as
 BoTorch does: on a smooth function with long length-scales the level is poorly determined, and that term made the
-far corners of a trust region look promising (Rosenbrock-6 at 300 simulations left its valley).  Measured with
-``benchmarks/bench_default.py`` (10 seeds; BENCHMARKS.md), median gap at 30 simulations: cosine_bowl3 0.080 ->
-0.038 %, Hartmann-3 0.0047 -> 0.0035 %, Styblinski-Tang-3 3.19 -> 1.37 %, cosine_bowl4 15.0 -> 10.7 %, Hartmann-4
-1.50 -> 0.56 %; median best value at 500: Ackley-8 0.495 -> 0.0051, Levy-8 0.909 -> 5.6e-6; Rosenbrock-6 at 300 2.35 ->
-2.50.
+far corners of a trust region look promising (Rosenbrock-6 at 300 simulations left its valley).
 
 The optional prior on the length-scales is the dimension-scaled log-normal of Hvarfner, Hellsten & Nardi (2024):
 log ℓ ~ N(√2 + ½ log d, √3), derived for many variables, where a few dozen designs leave most length-scales
@@ -67,9 +60,8 @@ _LOG_ADDITIVE_START = math.log(0.1)
 #: Log of the share of the product's variance below which the additive component is left out of a fitted model.
 _NEGLIGIBLE = math.log(1e-3)
 #: L-BFGS-B's relative tolerance on the log posterior: 1e-7 of it is a few 1e-5 nats at 150 designs, far below any
-#: difference of evidence that tells hyperparameters apart.  scipy's default (2.2e-9) spent half the evaluations of
-#: a warm-started refit in line searches that moved the evidence by less (an ad hoc count on Rosenbrock-6 at 300
-#: simulations: 13 100 evaluations and 37 s of fits against 7 500 and 20 s).
+#: difference of evidence that tells hyperparameters apart.  scipy's default (2.2e-9) spends about half the
+#: evaluations of a warm-started refit in line searches that move the evidence by less.
 _FTOL = 1e-7
 #: Correlation with the nearest design below which a fitted model is taken for white noise (:func:`fit_gp`).
 _NO_NEIGHBOUR = 0.05
@@ -206,13 +198,13 @@ class GaussianProcess:
 def _inverse(L: np.ndarray) -> np.ndarray:
     """K⁻¹ from the lower Cholesky factor L of K by LAPACK's ``potri`` (a triangular inverse and one product).
 
-    Solving for the identity's n columns took about a sixth of the method's own time at 6-D; ``potri`` takes a little
-    over half as long (an ad hoc timing, 150 designs, one thread: 0.53 ms against 0.92 ms).
+    ``potri`` takes a little over half as long as solving for the identity's n columns, which costs a sixth of the
+    method's own time at 6-D.
     """
     inv, info = dpotri(L, lower=1)
     if info:
         raise np.linalg.LinAlgError(f"potri failed with info {info}")
-    # potri fills the lower triangle only; mirrored in place (np.tril plus its transpose took twice as long, ad hoc).
+    # potri fills the lower triangle only; mirrored in place (np.tril plus its transpose takes twice as long).
     inv = np.tril(inv)
     inv += inv.T
     inv[np.diag_indices_from(inv)] *= 0.5
@@ -257,7 +249,8 @@ def _neg_log_posterior(theta: np.ndarray, X: np.ndarray, y: np.ndarray, prior_mu
 
 
 def fit_gp(X: np.ndarray, y: np.ndarray, rng: np.random.Generator, warm: np.ndarray | None = None,
-           starts: int = 3, maxiter: int = 100, prior: bool = True, spacing_floor: bool = False) -> GaussianProcess:
+           starts: int = 3, maxiter: int = 100, prior: bool = True, spacing_floor: bool = False,
+           additive: bool = True, quadratic: bool | None = None) -> GaussianProcess:
     """Fit the hyperparameters by L-BFGS-B on the log posterior from ``starts`` points and keep the best.
 
     Parameters
@@ -279,6 +272,10 @@ def fit_gp(X: np.ndarray, y: np.ndarray, rng: np.random.Generator, warm: np.ndar
     spacing_floor : bool
         When the fitted model correlates no design with its nearest neighbour (:func:`_sees_no_neighbour`), fit it
         again with no length-scale shorter than half the designs' median nearest-neighbour distance.
+    additive : bool
+        Fit the first-order additive component beside the product kernel (default), or the product kernel alone.
+    quadratic : bool, optional
+        The prior mean's form (:class:`GaussianProcess`); default: quadratic where the designs pay for it.
 
     Notes
     -----
@@ -287,17 +284,15 @@ def fit_gp(X: np.ndarray, y: np.ndarray, rng: np.random.Generator, warm: np.ndar
     expected improvement is flat, the next design lands beside the best one, and the fit after it takes a variable
     for irrelevant: the run refines the basin of the best design of its Sobol set.  The data cannot tell a
     correlation length shorter than their own spacing from none; the floor asks for the shortest one they can
-    resolve.  Measured *ad hoc* (``auto_search`` at 30 simulations, 17 functions of 2 to 4 variables, 12 of them
-    outside the suite, 20 seeds; median gap before -> after): cosine_bowl3 0.92 -> 0.067 %, cosine_bowl4 7.7 ->
-    6.6 %, Hartmann-4 0.35 -> 0.11 %, Levy-4 0.71 -> 0.28 %, Hartmann-3 0.0002 -> 0.0007 %, Styblinski-Tang-3
-    0.006 -> 0.008 %, Michalewicz-3 0.10 -> 0.29 %; runs within 1 % of the range 207 -> 213 of 340.  The floor
-    applied at every fit took Michalewicz-3, whose wells are narrower than the designs' spacing, to 21 %, and
-    Styblinski-Tang-3 to 3.0 % (the additive component, which shares the length-scales, lost its share).
+    resolve.  It applies only to a fit that sees white noise: at every fit it would hide wells narrower than the
+    designs' spacing (Michalewicz) and take its share from the additive component, which shares the length-scales
+    (the measurements: ``docs/guide/design-evidence.md``).
     """
-    gp = _fit(X, y, rng, warm, starts, maxiter, prior, _LOG_ELL[0])
+    gp = _fit(X, y, rng, warm, starts, maxiter, prior, _LOG_ELL[0], additive, quadratic)
     if spacing_floor and X.shape[0] > 1 and _sees_no_neighbour(gp):
         floor = math.log(max(0.5 * _median_spacing(X), 1e-12))
-        gp = _fit(X, y, rng, None, starts, maxiter, prior, min(max(_LOG_ELL[0], floor), _LOG_ELL[1]))
+        gp = _fit(X, y, rng, None, starts, maxiter, prior, min(max(_LOG_ELL[0], floor), _LOG_ELL[1]), additive,
+                  quadratic)
     return gp
 
 
@@ -321,32 +316,33 @@ def _prior_mean(d: int) -> float:
 
 
 def _fit(X: np.ndarray, y: np.ndarray, rng: np.random.Generator, warm: np.ndarray | None, starts: int,
-         maxiter: int, prior: bool, log_ell_min: float) -> GaussianProcess:
+         maxiter: int, prior: bool, log_ell_min: float, additive: bool = True,
+         quadratic: bool | None = None) -> GaussianProcess:
     """:func:`fit_gp` with ``log_ell_min`` as the lower bound of every log length-scale."""
     d = X.shape[1]
     prior_mu = _prior_mean(d)
     log_ell = (log_ell_min, _LOG_ELL[1])
-    bounds = [log_ell] * d + [_LOG_SIGNAL, _LOG_NOISE, _LOG_ADDITIVE]
+    bounds = [log_ell] * d + [_LOG_SIGNAL, _LOG_NOISE] + ([_LOG_ADDITIVE] if additive else [])
     lo, hi = np.array(bounds).T
-    if warm is not None and warm.size == d + 2:
-        # The previous fit left the additive component out (below): it restarts from where it was left.
-        warm = np.append(warm, _LOG_ADDITIVE[0])
+    if warm is not None:
+        # A previous fit that left the additive component out (below) restarts it from where it was left.
+        warm = np.append(warm, _LOG_ADDITIVE[0]) if additive and warm.size == d + 2 else warm[: len(bounds)]
     cands = [] if warm is None else [np.clip(warm, lo, hi)]
     while len(cands) < max(starts, 1):
         ell = np.clip(prior_mu + math.sqrt(3.0) * rng.standard_normal(d), *log_ell)
-        cands.append(np.concatenate([ell, [0.0, math.log(1e-4), _LOG_ADDITIVE_START]]))
+        cands.append(np.concatenate([ell, [0.0, math.log(1e-4)] + ([_LOG_ADDITIVE_START] if additive else [])]))
     best, best_val = cands[0], np.inf
     for theta0 in cands:
         res = minimize(_neg_log_posterior, theta0, args=(X, y, prior_mu, float(prior)), jac=True, method="L-BFGS-B",
                        bounds=bounds, options={"maxiter": maxiter, "ftol": _FTOL})
         if res.fun < best_val:
             best, best_val = res.x, res.fun
-    if best[d + 2] < best[d] + _NEGLIGIBLE:
+    if additive and best[d + 2] < best[d] + _NEGLIGIBLE:
         # The evidence gave the additive component (next to) nothing: the model is the product kernel's, and
         # predicting without the component's d terms a pair of designs is cheaper (Hartmann-6 at 300 simulations:
         # 55 s of the method's own time instead of 65 s).
         best = best[: d + 2]
-    return GaussianProcess(X, y, best)
+    return GaussianProcess(X, y, best, quadratic)
 
 
 def noise_log_bayes_factor(gp: GaussianProcess, n: int, prior: bool, null_noise: float) -> float:

@@ -8,17 +8,11 @@
   the trust regions a batch of several designs a step is the minimisers of as many posterior draws (Thompson
   sampling, TuRBO's choice): the kriging believer spreads a batch to the region's corners.
 
-  From 5 variables up the trust regions used to start at the Sobol design, on the argument that a global GP in
-  many variables is mostly uncertainty and its expected improvement runs to the box's corners.  With the model as
-  it is now (a constant mean by generalised least squares, the additive component) that no longer holds: measured
-  with ``auto_search``, median gap % of the range, 10 seeds, trust regions from the start -> the global model:
-  Hartmann-6 at 60 0.0028 -> 0.0001, Levy-8 at 100 0.97 -> 0.40, Ackley-8 at 100 27.3 -> 11.4, and on landscapes
-  outside the suite Michalewicz-5 at 40 53.2 -> 21.5 and at 100 6.7 -> 0.89, Ackley-12 at 150 (5 seeds) 59.4 ->
-  17.6, Rosenbrock-10 at 150 0.0088 -> 0.0039; Rosenbrock-6 at 60, Griewank-8 at 200, Rastrigin-6 at 150,
-  Zakharov-8 at 200 and Hartmann-3 hidden in 10 variables the same; worse: Levy-12 at 150 1.0 -> 2.0 (5 seeds),
-  Branin hidden in 12 variables 0.0000 -> 0.0001.  What the trust regions do better is refine a sharp minimum with
-  hundreds of simulations (``benchmarks/bench_default.py``, Ackley-8 at 500: 0.0174 -> 0.159 %, both far below
-  every peer's 4 % and more), and they now take over from the 300th design instead of from the Sobol design.
+  The global model starts in every dimension, 5 variables and more too: with a mean level by generalised least
+  squares and the additive component, a global GP in many variables is not mostly uncertainty, and it beats trust
+  regions started at the Sobol design at every budget up to 200 on nearly every landscape tried.  What the trust
+  regions do better is refine a sharp minimum with hundreds of simulations, so they take over from the 300th
+  design (the measurements: ``docs/guide/design-evidence.md``).
 
 * ``least-squares`` (any d, when the problem declares residuals): Gauss-Newton runs on the residuals from the
   starts that multi-level single linkage picks in a growing Sobol sample (:mod:`mechopt.optimize.least_squares`).

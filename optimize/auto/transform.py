@@ -7,18 +7,12 @@ everything that matters.  Both transforms below are monotone, so the ordering an
 * A local model (the trust regions that continue a budget beyond the global model's size): above the median the
   values are mapped through log1p of their robust z-score, then the whole is standardised.
 * A global model (the ``global`` plan) has to see the walls between basins, and that fixed compression flattened
-  them (measured on Styblinski–Tang 3-D at 30 simulations: median gap 4.5 % compressed, 0.6 % plain, same six
-  seeds).  Its values go through the Yeo-Johnson power transform whose exponent λ makes them most nearly Gaussian,
+  them.  Its values go through the Yeo-Johnson power transform whose exponent λ makes them most nearly Gaussian,
   as the GP assumes (maximum likelihood; HEBO's transform, Cowen-Rivers et al. 2022), only where the values reject
   λ = 1 (no transform) by a likelihood-ratio test at 5 % (χ²₁: 3.84): a long upper tail, Rosenbrock's walls, a
   squared error's decades.  λ is capped at 1: a power above 1 would compress the low tail, the few deep designs a
-  minimiser has to resolve.  Applied always, the transform lost the ventilator at 20 simulations (+0.03 -> +0.30 %);
-  with the test, measured on 17 functions of 2 to 4 variables at 30 simulations (12 outside the suite, 20 seeds, an
-  ad hoc run), median gap before -> after: Rosenbrock-4 0.30 -> 0.069 %, Powell 0.12 -> 0.021 %, Colville 0.072 ->
-  0.0088 %, Dixon-Price-3 0.022 -> 0.00087 %, six-hump camel 0.015 -> 0.000005 %, Styblinski–Tang-3 0.11 -> 0.006 %;
-  a design within 1 % of the range in 207 runs of 340 instead of 200; ventilator (``mechopt compare``, 10 seeds)
-  +0.03 -> +0.01 % at 20.  Which basin a run of a multimodal function ends in moves with any change of rounding
-  (cosine_bowl3 at 30, 20 seeds, ``benchmarks/bench_default.py``: 0.035 -> 0.915 %, 12 -> 11 runs in its basin).
+  minimiser has to resolve.  The test keeps the identity where the values do not ask for a transform: applied
+  always, it cost the ventilator (the measurements: ``docs/guide/design-evidence.md``).
 """
 
 from __future__ import annotations

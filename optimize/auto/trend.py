@@ -13,19 +13,13 @@ d(d − 1)/2 cross terms would need as many designs as a full quadratic response
 constant only when there are :data:`DESIGNS_PER_TERM` designs a coefficient and the Bayesian information criterion
 prefers it: its 2d terms must reduce the residuals' squared Mahalanobis norm under the fitted covariance by more
 than 2d·log n.  The covariance's hyperparameters are fitted under the constant mean, and the trend chosen at them
-afterwards, in the order of blind kriging (Joseph, Hung & Sudjianto 2008).  With the trend's coefficients profiled
-out of the evidence instead, the length-scales were fitted to what an over-fitted trend left: Hartmann-4 at 30
-simulations reached 0.5 % of its range in 6 runs of 30 instead of 20.  The trend's own uncertainty is left out of
-the variance, as the constant level's is (:mod:`~mechopt.optimize.auto.gp`).
+afterwards, in the order of blind kriging (Joseph, Hung & Sudjianto 2008): profiled out of the evidence, the
+trend's coefficients would leave the length-scales fitted to what an over-fitted trend left.  The trend's own
+uncertainty is left out of the variance, as the constant level's is (:mod:`~mechopt.optimize.auto.gp`).
 
-Measured *ad hoc* (``auto_search`` at 30 simulations, 30 seeds, median gap % of the range and runs within 0.5 %;
-constant -> quadratic always -> quadratic by the criterion): cosine_bowl4 9.70 (5) -> 3.24 (8) -> 3.21 (6),
-cosine_bowl3 0.049 (17) -> 0.079 (20) -> 0.023 (21), Hartmann-4 0.216 (14 of 20) -> 0.130 (20) -> 0.155 (19),
-Styblinski-Tang-3 0.011 (16) -> 0.0088 (17) -> 0.043 (17), Hartmann-3 0.0005 (19 of 20) -> 0.0002 (30) -> 0.0002
-(29).  The criterion is what keeps the constant on landscapes that are no bowl, which the trend always taken
-misled (12 seeds at 40 simulations, from ``benchmarks/bench_unseen.py``): Schwefel-4 7.1 -> 10.2 -> 7.1 %,
-Michalewicz-5 18.3 -> 24.5 -> 18.3 %; on Hartmann-3 with noise of 5 % of its range the criterion keeps the
-constant too.  Suite, peers and budgets up to 500: BENCHMARKS.md.
+The criterion is what keeps the constant on landscapes that are no bowl (Schwefel, Michalewicz), which a trend
+always taken misleads.  The measurements: ``docs/guide/design-evidence.md``; suite, peers and budgets up to 500:
+BENCHMARKS.md.
 """
 
 from __future__ import annotations

@@ -1,8 +1,10 @@
-"""Bayesian optimisation with a Gaussian process and expected improvement, written with numpy and scipy.
+"""Bayesian optimisation with a Gaussian process and expected improvement: a plain EGO.
 
-GP: constant mean (the data are standardised), anisotropic Matérn-5/2 kernel on the unit cube of the box, Gaussian
-noise; hyperparameters (log length scales, log signal and noise variances) by ML-II, i.e. L-BFGS-B on the log
-marginal likelihood with its analytic gradient, warm-started from the previous fit plus random restarts.
+GP: mechopt's own (:mod:`mechopt.optimize.auto.gp`) with its extras off, i.e. ordinary kriging: a constant mean
+estimated by generalised least squares, an anisotropic Matérn-5/2 kernel on the unit cube of the box, Gaussian noise,
+hyperparameters (log length scales, log signal and noise variances) by ML-II (no prior, no additive component, no
+quadratic trend), L-BFGS-B on the log marginal likelihood with its analytic gradient, warm-started from the previous
+fit plus random restarts.  The targets are standardised before the fit.
 Acquisition: expected improvement (Mockus 1978; Jones, Schonlau & Welch 1998) over the best feasible value,
 maximised on random candidates (uniform plus Gaussian perturbations of the incumbent), the best few polished by
 L-BFGS-B.
@@ -17,177 +19,50 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.linalg import cho_factor, cho_solve, solve_triangular
 from scipy.optimize import OptimizeResult, minimize
 from scipy.special import ndtr
 
+from mechopt.optimize.auto.gp import GaussianProcess, fit_gp
 from mechopt.optimize.budget import BudgetExhausted, CountedProblem
 
-__all__ = ["GaussianProcess", "expected_improvement", "minimize_bayesian"]
+__all__ = ["FIRST_GUESS", "expected_improvement", "fit_plain_gp", "minimize_bayesian"]
 
-_SQRT5 = math.sqrt(5.0)
+#: Length-scale (unit cube), signal and noise variance (standardised values) the first fit starts from.  The shared
+#: GP's random starts are drawn for long length-scales; on a smooth function a plain ML-II fit from there at unit
+#: signal variance can slide into the white-noise corner (every length-scale on its lower bound), which a start at
+#: a third of the cube does not.
+FIRST_GUESS = (0.3, 1.0, 1e-4)
 
 
-class GaussianProcess:
-    """Gaussian-process regression with an anisotropic Matérn-5/2 kernel and ML-II hyperparameters.
+def fit_plain_gp(U: np.ndarray, y: np.ndarray, rng: np.random.Generator, warm: np.ndarray | None = None,
+                 restarts: int = 2) -> GaussianProcess:
+    """Ordinary kriging of values at designs: the shared GP with its extras off, fitted by ML-II.
 
     Parameters
     ----------
-    length_bounds : (float, float), default (1e-2, 1e2)
-        Bounds of the length scales, in the units of the inputs (the unit cube in this package).
-    signal_bounds : (float, float), default (1e-2, 1e2)
-        Bounds of the signal variance of the standardised outputs.
-    noise_bounds : (float, float), default (1e-8, 1e-1)
-        Bounds of the noise variance of the standardised outputs (a deterministic simulator drives it down).
+    U : ndarray, shape (n, d)
+        Designs in the unit cube.
+    y : ndarray, shape (n,)
+        Finite values, in any unit; standardised (mean 0, standard deviation 1) before the fit.
+    rng : numpy.random.Generator
+        Source of the random starts of the hyperparameter fit.
+    warm : ndarray, optional
+        A previous fit's ``theta`` (d + 2 entries), tried first; default :data:`FIRST_GUESS`'s.
+    restarts : int, default 2
+        Random starts besides ``warm``.
 
-    Attributes
-    ----------
-    theta : ndarray
-        ``[log l_1..l_d, log signal variance, log noise variance]`` after :meth:`fit`.
+    Returns
+    -------
+    GaussianProcess
+        Fitted on the standardised values: its :meth:`~GaussianProcess.predict` gives the mean and standard
+        deviation of ``(y - mean(y)) / std(y)``.
     """
-
-    def __init__(
-        self,
-        length_bounds: tuple[float, float] = (1e-2, 1e2),
-        signal_bounds: tuple[float, float] = (1e-2, 1e2),
-        noise_bounds: tuple[float, float] = (1e-8, 1e-1),
-    ) -> None:
-        self.length_bounds = length_bounds
-        self.signal_bounds = signal_bounds
-        self.noise_bounds = noise_bounds
-        self.theta: np.ndarray | None = None
-
-    def _log_bounds(self, d: int) -> list[tuple[float, float]]:
-        lb = [tuple(np.log(self.length_bounds))] * d
-        return lb + [tuple(np.log(self.signal_bounds)), tuple(np.log(self.noise_bounds))]
-
-    @staticmethod
-    def _scaled_sq(X1: np.ndarray, X2: np.ndarray, lengths: np.ndarray) -> np.ndarray:
-        """Per-dimension squared scaled differences, shape (n1, n2, d)."""
-        return ((X1[:, None, :] - X2[None, :, :]) / lengths) ** 2
-
-    @staticmethod
-    def _matern(sq: np.ndarray, signal: float) -> tuple[np.ndarray, np.ndarray]:
-        """Kernel matrix and the common factor of its length-scale derivatives."""
-        r = np.sqrt(np.sum(sq, axis=-1))
-        e = np.exp(-_SQRT5 * r)
-        k = signal * (1.0 + _SQRT5 * r + 5.0 / 3.0 * r**2) * e
-        # d k / d log l_i = signal * 5/3 * (1 + sqrt5 r) exp(-sqrt5 r) * sq_i
-        return k, signal * 5.0 / 3.0 * (1.0 + _SQRT5 * r) * e
-
-    def neg_log_marginal_likelihood(self, theta: np.ndarray) -> tuple[float, np.ndarray]:
-        """Negative log marginal likelihood of the standardised training data and its gradient.
-
-        Parameters
-        ----------
-        theta : ndarray, shape (d + 2,)
-            ``[log l_1..l_d, log signal variance, log noise variance]``.
-
-        Returns
-        -------
-        value : float
-        gradient : ndarray, shape (d + 2,)
-        """
-        X, y = self._X, self._y
-        n, d = X.shape
-        lengths, signal, noise = np.exp(theta[:d]), math.exp(theta[d]), math.exp(theta[d + 1])
-        sq = self._scaled_sq(X, X, lengths)
-        k, common = self._matern(sq, signal)
-        K = k + (noise + 1e-10) * np.eye(n)
-        try:
-            c, low = cho_factor(K, lower=True)
-        except np.linalg.LinAlgError:
-            return 1e25, np.zeros(d + 2)
-        alpha = cho_solve((c, low), y)
-        value = 0.5 * y @ alpha + np.sum(np.log(np.diag(c))) + 0.5 * n * math.log(2.0 * math.pi)
-        # d(-log L)/dθ = -0.5 tr((α αᵀ - K⁻¹) dK/dθ)
-        inner = np.outer(alpha, alpha) - cho_solve((c, low), np.eye(n))
-        grad = np.empty(d + 2)
-        for i in range(d):
-            grad[i] = -0.5 * np.sum(inner * (common * sq[:, :, i]))
-        grad[d] = -0.5 * np.sum(inner * k)
-        grad[d + 1] = -0.5 * noise * np.trace(inner)
-        return float(value), grad
-
-    def fit(
-        self, X: np.ndarray, y: np.ndarray, *, rng: np.random.Generator | None = None, n_restarts: int = 2
-    ) -> GaussianProcess:
-        """Standardise the data and fit the hyperparameters by ML-II.
-
-        Parameters
-        ----------
-        X : ndarray, shape (n, d)
-            Inputs (the unit cube of the box in this package).
-        y : ndarray, shape (n,)
-            Finite outputs.
-        rng : numpy.random.Generator, optional
-            Source of the random restarts (none without it).
-        n_restarts : int, default 2
-            Random restarts besides the warm start (the previous ``theta``, or a default guess on the first fit).
-
-        Returns
-        -------
-        GaussianProcess
-            ``self``, fitted.
-        """
-        X = np.atleast_2d(np.asarray(X, dtype=float))
-        y = np.asarray(y, dtype=float).ravel()
-        self._mean = float(np.mean(y))
-        self._scale = float(np.std(y)) or 1.0
-        self._X, self._y = X, (y - self._mean) / self._scale
-        d = X.shape[1]
-        bounds = self._log_bounds(d)
-        # Warm start from the previous fit (hyperparameters move little when one point is added), else a guess.
-        if self.theta is not None and self.theta.size == d + 2:
-            starts = [self.theta]
-        else:
-            starts = [np.concatenate([np.full(d, math.log(0.3)), [0.0, math.log(1e-4)]])]
-        if rng is not None:
-            lo, hi = np.array(bounds).T
-            starts += [lo + rng.random(d + 2) * (hi - lo) for _ in range(n_restarts)]
-        best_theta, best_value = starts[0], math.inf
-        for t0 in starts:
-            res = minimize(self.neg_log_marginal_likelihood, np.clip(t0, *np.array(bounds).T), jac=True,
-                           method="L-BFGS-B", bounds=bounds, options={"maxiter": 200})
-            if res.fun < best_value:
-                best_theta, best_value = res.x, float(res.fun)
-        self.theta = np.asarray(best_theta, dtype=float)
-        self._factorise()
-        return self
-
-    def _factorise(self) -> None:
-        X, d = self._X, self._X.shape[1]
-        lengths, signal, noise = np.exp(self.theta[:d]), math.exp(self.theta[d]), math.exp(self.theta[d + 1])
-        k, _ = self._matern(self._scaled_sq(X, X, lengths), signal)
-        K = k + (noise + 1e-10) * np.eye(X.shape[0])
-        jitter = 0.0
-        while True:
-            try:
-                self._chol = np.linalg.cholesky(K + jitter * np.eye(K.shape[0]))
-                break
-            except np.linalg.LinAlgError:
-                jitter = max(10.0 * jitter, 1e-10)
-        self._alpha = cho_solve((self._chol, True), self._y)
-
-    def predict(self, Xs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Posterior mean and standard deviation of the latent function, in the units of ``y``.
-
-        Parameters
-        ----------
-        Xs : ndarray, shape (m, d)
-
-        Returns
-        -------
-        mean, std : ndarray, shape (m,)
-        """
-        Xs = np.atleast_2d(np.asarray(Xs, dtype=float))
-        d = self._X.shape[1]
-        lengths, signal = np.exp(self.theta[:d]), math.exp(self.theta[d])
-        ks, _ = self._matern(self._scaled_sq(Xs, self._X, lengths), signal)
-        mean = ks @ self._alpha
-        v = solve_triangular(self._chol, ks.T, lower=True)
-        var = np.maximum(signal - np.sum(v**2, axis=0), 1e-12)
-        return self._mean + self._scale * mean, self._scale * np.sqrt(var)
+    scale = float(np.std(y)) or 1.0
+    z = (np.asarray(y, dtype=float) - float(np.mean(y))) / scale
+    if warm is None:
+        ell, signal, noise = FIRST_GUESS
+        warm = np.log(np.concatenate([np.full(U.shape[1], ell), [signal, noise]]))
+    return fit_gp(U, z, rng, warm=warm, starts=restarts + 1, prior=False, additive=False, quadratic=False)
 
 
 def expected_improvement(mean: np.ndarray, std: np.ndarray, best: float) -> np.ndarray:
@@ -250,7 +125,7 @@ def minimize_bayesian(
         return problem.result("no feasible initial design found", nit=0)
     U: list[np.ndarray] = []
     Y: list[float] = []
-    gp = GaussianProcess()
+    theta: np.ndarray | None = None
     n_it = 0
 
     def observe(u: np.ndarray) -> None:
@@ -273,7 +148,8 @@ def minimize_bayesian(
                 continue
             y = np.where(finite, y, np.max(y[finite]))
             Uarr = np.array(U)
-            gp.fit(Uarr, y, rng=rng, n_restarts=2 if n_it % refit_restarts_every == 0 else 0)
+            gp = fit_plain_gp(Uarr, y, rng, warm=theta, restarts=2 if n_it % refit_restarts_every == 0 else 0)
+            theta = gp.theta
             pick = _acquire(problem, gp, Uarr, y, finite, rng, n_candidates=n_candidates,
                             n_local_candidates=n_local_candidates, n_polish=n_polish)
             observe(np.asarray(pick, dtype=float))
@@ -300,7 +176,7 @@ def _acquire(
     ----------
     problem : CountedProblem
     gp : GaussianProcess
-        Fitted on ``U`` and ``y``.
+        Fitted on ``U`` and ``y`` standardised (:func:`fit_plain_gp`).
     U : ndarray, shape (n, d)
         Simulated designs in the unit cube.
     y : ndarray, shape (n,)
@@ -323,11 +199,12 @@ def _acquire(
         If no candidate is feasible.
     """
     d = problem.dim
-    best = float(np.min(y[finite]))
+    # The expected improvement of the standardised values: the same maximiser, the GP's own units.
+    best = float((np.min(y[finite]) - np.mean(y)) / (float(np.std(y)) or 1.0))
     incumbent = U[int(np.argmin(np.where(finite, y, np.inf)))]
     cand = np.vstack([rng.random((n_candidates, d)),
                       np.clip(incumbent + 0.05 * rng.standard_normal((n_local_candidates, d)), 0.0, 1.0)])
-    cand = cand[problem.feasible_many(problem.from_unit(cand))]
+    cand = cand[problem.feasible(problem.from_unit(cand))]
     if cand.shape[0] == 0:
         raise BudgetExhausted("no feasible candidate found for the acquisition")
     ei = expected_improvement(*gp.predict(cand), best)
@@ -339,7 +216,7 @@ def _acquire(
 
     for j in top:
         res = minimize(neg_ei, cand[j], method="L-BFGS-B", bounds=[(0.0, 1.0)] * d)
-        if -res.fun > pick_ei and problem.feasible(problem.from_unit(res.x)):
+        if -res.fun > pick_ei and problem.feasible(problem.from_unit(res.x))[0]:
             pick, pick_ei = res.x, -res.fun
     if np.min(np.linalg.norm(U - pick, axis=1)) < 1e-9:
         # EI has collapsed onto a known design: explore instead of re-simulating (cached) forever.

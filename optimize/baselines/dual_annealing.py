@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import OptimizeResult, dual_annealing
 
+from mechopt.errors import InputError
 from mechopt.optimize.budget import BudgetExhausted, CountedProblem
 from mechopt.optimize.sparse.local_search import feasible_side_gradient
 
@@ -49,7 +50,7 @@ def minimize_dual_annealing(
         Best feasible simulated design (``x``, ``fun``), ``nfev``, ``success``, ``message``.
     """
     if local_search not in ("slsqp", "l-bfgs-b"):
-        raise ValueError(f"local_search must be 'slsqp' or 'l-bfgs-b', got {local_search!r}")
+        raise InputError(f"local_search must be 'slsqp' or 'l-bfgs-b', got {local_search!r}")
     rng = np.random.default_rng(seed)
 
     def energy(x: np.ndarray) -> float:

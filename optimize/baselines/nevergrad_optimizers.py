@@ -134,7 +134,7 @@ class _Feasible:
         self.problem = problem
 
     def __call__(self, x: np.ndarray) -> bool:
-        return self.problem.feasible(np.asarray(x, dtype=float))
+        return bool(self.problem.feasible(np.asarray(x, dtype=float))[0])
 
 
 def _run(problem: CountedProblem, seed: int, optimizer_name: str, purpose: str) -> OptimizeResult:
@@ -162,7 +162,7 @@ def _run(problem: CountedProblem, seed: int, optimizer_name: str, purpose: str) 
                 candidate = optimizer.ask()
                 n_asked += 1
                 x = np.asarray(candidate.value, dtype=float)
-                if not problem.feasible(x):
+                if not problem.feasible(x)[0]:
                     n_rejected += 1
                     problem.penalised(x)  # counts the proposal, never simulates
                     optimizer.tell(candidate, rejected_value(problem, x))

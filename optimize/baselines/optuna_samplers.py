@@ -42,6 +42,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import OptimizeResult
 
+from mechopt.errors import InputError
 from mechopt.optimize.baselines.library import rejected_value, require
 from mechopt.optimize.budget import BudgetExhausted, CountedProblem
 
@@ -68,7 +69,7 @@ def _run(problem: CountedProblem, optuna: Any, sampler: Any, *, constraints: boo
             trial = study.ask(space)
             n_trials += 1
             x = np.array([trial.params[n] for n in names])
-            ok = problem.feasible(x)
+            ok = bool(problem.feasible(x)[0])
             if constraints:
                 for j, g in enumerate(problem.margins(x)):
                     trial.set_constraint(f"g{j}", -float(g))
@@ -174,7 +175,7 @@ def minimize_optuna_cmaes(
         ``nrejected``.
     """
     if infeasible not in ("resample", "penalty"):
-        raise ValueError(f"infeasible must be 'resample' or 'penalty', got {infeasible!r}")
+        raise InputError(f"infeasible must be 'resample' or 'penalty', got {infeasible!r}")
     optuna = require("optuna", "optuna_cmaes")
     require("cmaes", "optuna_cmaes")
     previous = _silenced(optuna)

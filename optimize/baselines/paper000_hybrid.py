@@ -5,8 +5,8 @@ as fitness (the problem's objective: one call = one "simulation"), then a local 
 distinct individuals, the best local minimum kept.  Here:
 
 * GA: a feasible Latin-hypercube initial population (uniform draws in the box are rarely feasible: 2 % in
-  example 1), binary tournament selection, SBX crossover and polynomial mutation (:mod:`.genetic`), 5 % elitism;
-  an infeasible child is not simulated and ranks by the paper's quadratic penalty, λ = 50 times the squared
+  example 1), binary tournament selection, SBX crossover and polynomial mutation (:mod:`.genetic_operators`), 5 %
+  elitism; an infeasible child is not simulated and ranks by the paper's quadratic penalty, λ = 50 times the squared
   violation above every simulated value (its Eq. 17 adds λ g² to E; a slider-crank whose crank cannot turn has no
   E to add it to);
 * local phase: SLSQP (scipy, bounded, the margins as inequality constraints, counted forward differences,
@@ -24,7 +24,7 @@ import math
 import numpy as np
 from scipy.optimize import OptimizeResult
 
-from mechopt.optimize.baselines.genetic import polynomial_mutation, sbx_crossover
+from mechopt.optimize.baselines.genetic_operators import polynomial_mutation, sbx_crossover
 from mechopt.optimize.budget import BudgetExhausted, CountedProblem, run_multistart
 from mechopt.optimize.sparse.local_search import local_slsqp
 

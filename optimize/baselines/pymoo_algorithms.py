@@ -75,7 +75,7 @@ def _pymoo_problem(problem: CountedProblem) -> Any:
                 box = np.sum(np.maximum(problem.lower - x, 0.0)) + np.sum(np.maximum(x - problem.upper, 0.0))
                 G[i, :n_margins] = -problem.margins(problem.clip(x))
                 G[i, n_margins] = box
-                if problem.feasible(x):
+                if problem.feasible(x)[0]:
                     f = problem.evaluate(x)  # raises BudgetExhausted when the budget is spent
                     F[i, 0] = f if math.isfinite(f) else problem.infeasible_value
                 else:

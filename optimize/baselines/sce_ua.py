@@ -18,6 +18,7 @@ import math
 import numpy as np
 from scipy.optimize import OptimizeResult
 
+from mechopt.errors import InputError
 from mechopt.optimize.budget import BudgetExhausted, CountedProblem
 
 __all__ = ["minimize_sce_ua"]
@@ -28,7 +29,7 @@ def _random_in_box(problem: CountedProblem, lo: np.ndarray, hi: np.ndarray, rng:
     """Uniform random feasible design in the box [lo, hi] (rejection), None when none is hit."""
     for _ in range(tries):
         z = lo + rng.random(lo.size) * (hi - lo)
-        if problem.feasible(z):
+        if problem.feasible(z)[0]:
             return z
     return None
 
@@ -79,7 +80,7 @@ def minimize_sce_ua(
     beta = m if n_evolution_steps is None else int(n_evolution_steps)
     p = int(n_complexes)
     if not 2 <= q <= m:
-        raise ValueError(f"need 2 <= subcomplex_size <= complex_size, got q={q}, m={m}")
+        raise InputError(f"need 2 <= subcomplex_size <= complex_size, got q={q}, m={m}")
     s = p * m
     points = _initial_points(problem, s, rng)
     if points is None:
@@ -162,7 +163,7 @@ def _offspring(problem: CountedProblem, sub_x: np.ndarray, sub_f: np.ndarray, cx
     centroid = sub_x[:-1].mean(axis=0)
     lo, hi = cx.min(axis=0), cx.max(axis=0)
     new_x, new_f = centroid + (centroid - worst), math.inf
-    if problem.feasible(new_x):
+    if problem.feasible(new_x)[0]:
         new_f = _value(problem, new_x)
     else:
         z = _random_in_box(problem, lo, hi, rng)
@@ -170,7 +171,7 @@ def _offspring(problem: CountedProblem, sub_x: np.ndarray, sub_f: np.ndarray, cx
             new_x, new_f = z, _value(problem, z)
     if not new_f < worst_f:
         new_x = 0.5 * (centroid + worst)
-        new_f = _value(problem, new_x) if problem.feasible(new_x) else math.inf
+        new_f = _value(problem, new_x) if problem.feasible(new_x)[0] else math.inf
         if not new_f < worst_f:
             z = _random_in_box(problem, lo, hi, rng)
             new_x, new_f = (z, _value(problem, z)) if z is not None else (worst, worst_f)

@@ -33,7 +33,21 @@ from scipy.optimize import OptimizeResult, minimize
 from mechopt.optimize.baselines.library import require, worst_feasible_value
 from mechopt.optimize.budget import BudgetExhausted, CountedProblem
 
-__all__ = ["minimize_smt_ego"]
+__all__ = ["EGO_MAX_BUDGETS", "max_budget", "minimize_smt_ego"]
+
+#: The largest budget ``mechopt compare`` runs EGO at, as (most variables, budget): each step refits Kriging (a
+#: hyperparameter search per variable) on every sample, a cost that grows with the cube of the simulations and with
+#: the dimension; these are the budgets where a step still takes about 3 s of CPU on one BLAS thread
+#: (benchmarks/bench_peer_budgets.py measures them; beyond 8 variables a step at 30 samples is not measured).
+EGO_MAX_BUDGETS = ((3, 100), (5, 60), (12, 30))
+
+
+def max_budget(dim: int) -> int:
+    """The largest budget ``mechopt compare`` runs EGO at on ``dim`` variables (:data:`EGO_MAX_BUDGETS`)."""
+    for most, budget in EGO_MAX_BUDGETS:
+        if dim <= most:
+            return budget
+    return EGO_MAX_BUDGETS[-1][1]
 
 
 def _constrained_ego(ego_class: type, problem: CountedProblem, rng: np.random.Generator, n_candidates: int) -> type:
@@ -64,7 +78,7 @@ def _constrained_ego(ego_class: type, problem: CountedProblem, rng: np.random.Ge
                 res = minimize(neg_ei, u0, method="SLSQP", bounds=[(0.0, 1.0)] * d, constraints=cons,
                                options={"maxiter": 200})
                 u = np.clip(res.x, 0.0, 1.0)
-                if np.isfinite(res.fun) and res.fun < best_val and problem.feasible(problem.from_unit(u)):
+                if np.isfinite(res.fun) and res.fun < best_val and problem.feasible(problem.from_unit(u))[0]:
                     best_u, best_val = u, float(res.fun)
             if best_u is None or np.min(np.linalg.norm(x_data - best_u, axis=1)) < 1e-9:
                 extra = problem.to_unit(problem.sample_feasible(1, rng))

@@ -21,7 +21,7 @@ __all__ = ["feasible_side_gradient", "gradient_designs", "local_slsqp"]
 
 def gradient_designs(problem: CountedProblem, x: np.ndarray, step: float = 1e-5) -> tuple[list[np.ndarray], list[bool]]:
     """The d designs :func:`feasible_side_gradient` asks for at ``x`` (and whether each is the forward one): known
-    before any simulation, so that they can be simulated together (issue 28)."""
+    before any simulation, so that they can be simulated together."""
     x = np.asarray(x, dtype=float)
     points, forward_side = [], []
     for i in range(x.size):
@@ -29,7 +29,7 @@ def gradient_designs(problem: CountedProblem, x: np.ndarray, step: float = 1e-5)
         forward, backward = x.copy(), x.copy()
         forward[i] += h
         backward[i] -= h
-        forward_side.append(bool(problem.feasible(forward) or not problem.feasible(backward)
+        forward_side.append(bool(problem.feasible(forward)[0] or not problem.feasible(backward)[0]
                                  and forward[i] <= problem.upper[i]))
         points.append(forward if forward_side[-1] else backward)
     return points, forward_side
@@ -59,8 +59,8 @@ def feasible_side_gradient(
     points, forward_side = gradient_designs(problem, x, step)
     prefetch = getattr(problem, "prefetch", None)
     if prefetch is not None:
-        # A problem that can simulate several designs at once gets the d + 1 designs of the gradient together
-        # (issue 28); the calls below then find them.
+        # A problem that can simulate several designs at once gets the d + 1 designs of the gradient together, as
+        # one round of the workers; the calls below then find them.
         prefetch(np.vstack([x, *points]))
     f0 = fun(x)
     g = np.zeros(x.size)
@@ -101,7 +101,7 @@ def local_slsqp(
     anchor = [problem.clip(np.asarray(x0, dtype=float))]
 
     def extended(x: np.ndarray) -> float:
-        if problem.feasible(x):
+        if problem.feasible(x)[0]:
             anchor[0] = x
         f = problem.extended(x, anchor[0])
         return f if math.isfinite(f) else problem.infeasible_value

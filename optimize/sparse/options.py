@@ -11,7 +11,7 @@ __all__ = ["LINE_SHARE", "MIN_HELD_OUT_POINTS", "PLAN_KEYS", "VALIDATION_SHARE",
 
 #: Largest share of the budget the lines of the global model may take: the rest (at least a tenth) is kept for the
 #: confirmation and the refinement on the simulator, which is what makes a larger budget never worse than a smaller
-#: one (issue 25: 147 of 150 on the lines left 3 to refine, and the answer was worse than at 60).
+#: one (lines that took 147 of 150 would leave 3 to refine, and the answer would be worse than at 60).
 LINE_SHARE = 0.9
 
 #: Held-out simulations of the default validation, as a share of the budget, on top of it.

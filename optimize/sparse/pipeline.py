@@ -118,7 +118,7 @@ def run_pipeline(space: ModelSpace, options: SparseOptions, sampler: Sampler,
         remaining = options.budget - (len(sampler.designs) - used_before)
         if remaining > 0:
             # Finite differences stop where the simulator's noise hides the gradient, often with budget left; the
-            # model corrected by every simulation of the run still sees the basin's bottom (issue 15).
+            # model corrected by every simulation of the run still sees the basin's bottom.
             tail = corrected_steps(space, sampler, stage, remaining, options.seed)
             stages.append(tail)
             log(f"  corrected steps: {tail.n_samples} simulations at the minimum of the model corrected by every "
@@ -136,7 +136,7 @@ def model_step_budget(remaining: int, batch: int) -> int:
     """The model steps' share of what is left: all of it one at a time (they stop by themselves once their region
     has shrunk, after 8 to 17 simulations at a budget of 60); with batches, :data:`BATCH_MODEL_STEP_SHARE` of it
     and at least one round, since a round of steps at several radii nearly always improves and they would not
-    stop (issue 28).  Whole rounds: a round of fewer than ``batch`` designs takes as long as a full one."""
+    stop.  Whole rounds: a round of fewer than ``batch`` designs takes as long as a full one."""
     if batch <= 1:
         return remaining
     return min(remaining, batch * max(1, math.ceil(BATCH_MODEL_STEP_SHARE * remaining / batch)))
@@ -144,7 +144,7 @@ def model_step_budget(remaining: int, batch: int) -> int:
 
 def _claim_text(stage: Stage, problem) -> str:
     """The model against the simulation at its candidate, absolute (the objective's unit) and as a share of the
-    range of the line samples: a percentage of a value near 0 says nothing (issue 25)."""
+    range of the line samples: a percentage of a value near 0 says nothing."""
     unit = dict(problem.output_units).get(problem.objective, "")
     diff = abs(stage.simulated - stage.predicted)
     share = "" if not np.isfinite(stage.claim_error) else (

@@ -105,7 +105,7 @@ def _gauss_newton(space: ModelSpace, sampler: Sampler, x0: np.ndarray, budget: i
 
 
 def _speculate(sampler: Sampler, problem: CountedProblem, x: np.ndarray, fd_step: float, left: int) -> None:
-    """A new design of the search goes out with the d designs of its gradient, in one round (issue 28).
+    """A new design of the search goes out with the d designs of its gradient, in one round.
 
     SLSQP asks for the gradient at nearly every design it simulates (the full step is accepted); the d + 1 designs
     then cost one round instead of two.  A design its line search rejects wastes its d gradient designs: the
@@ -116,12 +116,12 @@ def _speculate(sampler: Sampler, problem: CountedProblem, x: np.ndarray, fd_step
         return
     if left <= 0:
         raise BudgetExhausted("the refinement's budget is spent")
-    points = [p for p in gradient_designs(problem, x, fd_step)[0] if problem.feasible(p)]
+    points = [p for p in gradient_designs(problem, x, fd_step)[0] if problem.feasible(p)[0]]
     sampler(np.vstack([x, *points])[:left], desc="refinement")
 
 
 class _BatchedProblem(CountedProblem):
-    """A counted problem whose finite-difference gradients simulate their d points as one batch (issue 28).
+    """A counted problem whose finite-difference gradients simulate their d points as one batch.
 
     :func:`~mechopt.optimize.sparse.local_search.feasible_side_gradient` announces the designs it is about to ask
     for through :meth:`prefetch`; they are simulated together (at most what the budget still allows, in the order
@@ -146,7 +146,7 @@ class _BatchedProblem(CountedProblem):
             if left <= 0:
                 break
             left -= 1  # an infeasible design costs one simulation too (its boundary point): counted, not fetched
-            if self.feasible(x):
+            if self.feasible(x)[0]:
                 keys.add(key)
                 todo.append(x)
         if len(todo) > 1:

@@ -51,7 +51,7 @@ class Sampler:
         #: Every design of this run and its objective (NaN when failed), by key: what later steps model.
         self.history: dict[str, tuple[tuple[float, ...], float]] = {}
         self.sampling_time_s = 0.0
-        #: Rounds of simulations: calls that dispatched at least one design to the simulators (issue 28).
+        #: Rounds of simulations: calls that dispatched at least one design to the simulators.
         self.rounds = 0
         #: Waves: a round of n designs on w workers is ceil(n / w) of them (the simulation time, in simulations).
         self.waves = 0
@@ -114,7 +114,7 @@ class Sampler:
                         for r, v in zip(records, values, strict=True)]
 
     def timing(self) -> dict:
-        """Rounds, waiting and the method's own time since this sampler was made (issue 28).
+        """Rounds, waiting and the method's own time since this sampler was made.
 
         ``rounds``: calls that dispatched designs to the simulators; ``waves``: those calls in simulations one
         after the other (a call of n designs on w workers is ceil(n / w) waves); ``waiting_s``: wall time inside

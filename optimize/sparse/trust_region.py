@@ -83,7 +83,7 @@ def trust_region_steps(model: Callable[[np.ndarray], np.ndarray], simulate: Call
     margins : callable, optional
         Constraint margins of one design (d,) -> (m,), >= 0 when feasible, for the polish of each step.
     batch : int
-        Steps proposed at once (the free workers, issue 28; :meth:`_Steps.batch_step`); 1 (default): one at a time.
+        Steps proposed at once (the free workers; :meth:`_Steps.batch_step`); 1 (default): one at a time.
     simulate_batch : callable, optional
         The fitted quantity of designs (k, d) -> (k,), simulated together (default: ``simulate`` on each).
 

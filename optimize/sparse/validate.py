@@ -52,8 +52,8 @@ class Validation:
     def relative_text(self, unit: str = "") -> str:
         """The RMSE as a share of the held-out values' range, with that range in the objective's ``unit``.
 
-        Always the range, never the best value: a percentage of a value near 0 says nothing (issue 25 read
-        "RMSE 33.21 % of the best simulated value −0.05777").
+        Always the range, never the best value: a percentage of a value near 0 says nothing ("RMSE 33 % of the
+        best simulated value −0.058").
         """
         unit = f" {unit}" if unit else ""
         return f"{self.rmse_pct_of_range:.2f} % of the held-out values' range {self.spread:.4g}{unit}"

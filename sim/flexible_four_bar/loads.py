@@ -25,6 +25,7 @@ import math
 import numpy as np
 from numba import njit
 
+from mechopt.errors import InputError
 from mechopt.sim.flexible_four_bar.kinematics import rigid_state
 
 __all__ = ["DRIVE_COLUMNS", "drive_table", "drive_tables", "euler_load_ratios", "link_drives"]
@@ -126,7 +127,7 @@ def drive_table(lengths: tuple[float, float, float, float], omega: float, branch
                 masses: tuple[float, float], t: np.ndarray, link: int) -> np.ndarray:
     """Drive rows of link 3 (coupler) or 4 (follower) at the times ``t`` (see :func:`drive_tables`)."""
     if link not in (3, 4):
-        raise ValueError(f"link = {link!r}; expected 3 (coupler) or 4 (follower)")
+        raise InputError(f"link = {link!r}; expected 3 (coupler) or 4 (follower)")
     return drive_tables(lengths, omega, branch, masses, t)[link - 3]
 
 

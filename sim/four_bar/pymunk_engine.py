@@ -151,11 +151,11 @@ def simulate_pymunk(
     )
 
 
-def _run(design_m, mechanism, theta_ref, psi0, dt, iterations, hold_steps):
-    """Build the space, hold the start pose, run one cycle; return τ, θ, ψ and pymunk's |impulse|/dt per step."""
+def _build_space(design_m, mechanism, theta0, psi0, iterations):
+    """The mechanism at its start pose as pymunk bodies and joints; return the space, the stator, the crank, the
+    rocker and the crank's motor (its rate still zero)."""
     oa, ab, bc = design_m
     xc, yc = (v * MM for v in mechanism.pivot_c)
-    theta0 = float(theta_ref[0])
     a0 = (oa * np.cos(theta0), oa * np.sin(theta0))
     b0 = (xc + bc * np.cos(psi0), yc + bc * np.sin(psi0))
 
@@ -195,7 +195,13 @@ def _run(design_m, mechanism, theta_ref, psi0, dt, iterations, hold_steps):
     breaks, coefs = mechanism.load.breaks, mechanism.load.coefs
     load.torque_func = lambda _spring, rel_angle: -_load_at(breaks, coefs, psi0 - rel_angle)
     space.add(*joints, motor, load)
+    return space, stator, crank, rocker, motor
 
+
+def _run(design_m, mechanism, theta_ref, psi0, dt, iterations, hold_steps):
+    """Build the space, hold the start pose, run one cycle; return τ, θ, ψ and pymunk's |impulse|/dt per step."""
+    theta0 = float(theta_ref[0])
+    space, stator, crank, rocker, motor = _build_space(design_m, mechanism, theta0, psi0, iterations)
     target = [theta0]
     inv_dt = 1.0 / dt
 

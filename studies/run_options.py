@@ -2,8 +2,8 @@
 that fits the budget.
 
 A study's own line plan is sized for its own budget (the ventilator: 21 lines of 25 for 600 simulations).  Under a
-smaller ``--budget`` it would take every simulation and leave none to refine, and the answer got worse with more
-budget (issue 25: 147 of 150 on the lines, 3 left to refine).  So the plan the study (or the default) declares is
+smaller ``--budget`` it would take every simulation and leave none to refine (147 of 150 on the lines, 3 left to
+refine), and the answer would get worse with more budget.  So the plan the study (or the default) declares is
 kept only while it fits the lines' share of the budget (:meth:`SparseOptions.line_cap`); otherwise it is scaled to the
 budget as :meth:`SparseOptions.for_budget` scales it for :func:`mechopt.minimize`.  A plan given on the command line
 (``--lines-fit``, ``--samples-per-line``) is the user's and always kept.

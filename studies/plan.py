@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from mechopt.optimize.methods import get_method
 from mechopt.optimize.sparse.model import ObjectiveModel
 from mechopt.optimize.sparse.options import SparseOptions
 from mechopt.optimize.sparse.space import ModelSpace
@@ -23,11 +24,9 @@ from mechopt.optimize.sparse.stage import planned_designs
 from mechopt.runs.store import SampleStore, design_key
 from mechopt.studies.catalogue import Study
 
-__all__ = ["BATCH_METHODS", "PlanStage", "RunPlan", "duration_text", "open_store_if_any", "plan_run",
+__all__ = ["PlanStage", "RunPlan", "duration_text", "open_store_if_any", "plan_run",
            "plan_validation", "seconds_per_run"]
 
-#: The methods that propose as many designs at once as there are workers (issue 28).
-BATCH_METHODS = ("sparse", "sparse-global", "auto")
 
 
 @dataclass(frozen=True)
@@ -43,7 +42,7 @@ class PlanStage:
     held : int
         Of those, how many the store already holds (not simulated again).
     parallel : bool
-        Whether its designs run ``workers`` at a time (lines, held-out lines, and since issue 28 every step of the
+        Whether its designs run ``workers`` at a time (lines, held-out lines, and every step of the
         sparse methods, proposed in batches of ``workers``) or one after the other (the baselines).
     exact : bool
         Whether ``simulations`` is the count (True) or an upper bound (the refinement may stop earlier).
@@ -210,7 +209,7 @@ def plan_run(study: Study, options: SparseOptions, method: str, store: SampleSto
     options : SparseOptions
         The budget, the line plan and the validation.
     method : str
-        The optimizer (only ``"sparse"`` has lines to count and held-out lines to validate).
+        The optimizer (only a line model has lines to count and held-out lines to validate).
     store : SampleStore, optional
         The store the run will use (None: a new one).
     workers : int
@@ -222,7 +221,8 @@ def plan_run(study: Study, options: SparseOptions, method: str, store: SampleSto
     fingerprint = problem.fingerprint()
     budget = int(options.budget)
     stages: list[PlanStage] = []
-    if method == "sparse":
+    record = get_method(method)
+    if record.line_model:
         stages.append(_line_stage(study, options, store, retry_failed))
         n_lines = stages[-1].simulations
         stages.append(PlanStage("confirm the model's candidate", 1))
@@ -230,8 +230,8 @@ def plan_run(study: Study, options: SparseOptions, method: str, store: SampleSto
             stages.extend(_refinement(budget - n_lines - 1, workers, problem.dim))
         n_val_lines, per_line = options.validation_plan()
     else:
-        # sparse-global and auto propose batches of ``workers`` designs (issue 28); the baselines one at a time.
-        stages.append(PlanStage(f"method {method}", budget, parallel=method in BATCH_METHODS, exact=False))
+        # mechopt's other methods propose batches of ``workers`` designs; the baselines one at a time.
+        stages.append(PlanStage(f"method {method}", budget, parallel=record.batches, exact=False))
         n_val_lines, per_line = 0, 0
     validation = n_val_lines * per_line
     if validation:
@@ -281,7 +281,7 @@ def plan_validation(study: Study, options: SparseOptions, store: SampleStore | N
 def _refinement(left: int, workers: int, dim: int) -> list[PlanStage]:
     """The sparse method's refinement: one stage one at a time; with batches, the model steps in rounds of
     ``workers`` (whole rounds of their share of what is left, as the pipeline takes them) and the local search's
-    designs with their gradients, d + 1 a round (issue 28)."""
+    designs with their gradients, d + 1 a round."""
     from mechopt.optimize.sparse.pipeline import model_step_budget
 
     if workers <= 1:

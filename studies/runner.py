@@ -17,9 +17,6 @@ from typing import Any
 
 import numpy as np
 
-from mechopt.cli.study_header import study_header
-from mechopt.cli.study_options import study_options
-from mechopt.cli.study_plan import RunPlan, duration_text, open_store_if_any, plan_run, plan_validation
 from mechopt.errors import InputError, MechoptError
 from mechopt.optimize.arguments import check_method
 from mechopt.optimize.ground_truth import GroundTruth, load_or_compute
@@ -33,6 +30,9 @@ from mechopt.optimize.sparse.validate import Validation, validate
 from mechopt.runs.executors import check_reachable, default_workers, make_executor
 from mechopt.runs.store import SampleStore
 from mechopt.studies.catalogue import Study
+from mechopt.studies.plan import RunPlan, duration_text, open_store_if_any, plan_run, plan_validation
+from mechopt.studies.run_header import study_header
+from mechopt.studies.run_options import study_options
 
 __all__ = ["StudyRun", "check_output_folder", "check_run", "plan_study", "rounds_text", "run_study",
            "study_options", "summary_lines"]
@@ -147,7 +147,7 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
         references = _references(study, result.x, sampler)
         timings["references_s"] = time.perf_counter() - t0
         # The rounds, waiting and computing of the whole run (validation and references included) and, apart, of
-        # the optimisation alone (issue 28).
+        # the optimisation alone.
         sampling = {**sampler.summary(), "optimisation": n_opt, "validation": n_val,
                     "references": len(sampler.designs) - n_opt - n_val, "optimisation_timing": timing}
         failures = [(np.array(d), e) for d, e in sampler.failures.values()]
@@ -316,7 +316,7 @@ def _simulations_line(run: StudyRun) -> str:
 
 
 def rounds_text(s: dict[str, Any]) -> str:
-    """The parallel accounting of a run (issue 28): rounds, the workers' idle share, waiting and computing.
+    """The parallel accounting of a run: rounds, the workers' idle share, waiting and computing.
 
     A round is as the plan printed before the run counts it: simulations one after the other, up to ``workers`` at
     a time (the sampler's ``waves``; 8 Sobol designs on 2 workers are 4 rounds).  The method's calls to the
