@@ -27,6 +27,18 @@ def add_parsers(sub) -> None:
     p.set_defaults(func=run_init)
 
 
+def multi_objective_rows() -> list[tuple[str, str, str]]:
+    """``(name, kind, description)`` of every test problem with several objectives."""
+    from mechopt.studies.multi_objective_functions import MULTI_OBJECTIVE_SUITE
+
+    rows = []
+    for name, cls in sorted(MULTI_OBJECTIVE_SUITE.items()):
+        p = cls()
+        limits = f", {len(p.limits)} limits" if p.limits else ""
+        rows.append((name, f"test problem, {p.dim} variables, {len(p.objective)} objectives{limits}", cls.summary()))
+    return rows
+
+
 def study_lines() -> list[str]:
     """``name  kind, d variables: description`` for every packaged study, then every test function.
 
@@ -44,6 +56,7 @@ def study_lines() -> list[str]:
         rows.append((name, f"{config.get('kind', '?')}, {dim} variables", str(config.get("description", ""))))
     for name, cls in sorted(SUITE.items()):
         rows.append((name, f"test function, {cls().dim} variables", cls.summary()))
+    rows += multi_objective_rows()
     width = max(len(r[0]) for r in rows)
     return [f"{name:<{width}}  {what}: {text}" for name, what, text in rows]
 

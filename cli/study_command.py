@@ -7,6 +7,7 @@ from pathlib import Path
 
 from mechopt.cli.arguments import count, float_list, positive_float
 from mechopt.cli.study_arguments import add_method_option, add_run_options, add_study_argument, load, overrides
+from mechopt.cli.trade_off_options import add_trade_off_options, apply_trade_off, run_trade_off_command
 
 __all__ = ["add_parser", "run"]
 
@@ -29,6 +30,7 @@ def add_parser(sub, engines: tuple[str, ...]) -> None:
                    "the answer is never worse")
     p.add_argument("--truth", action="store_true", help="also brute-force the ground truth (cached)")
     p.add_argument("--truth-grid", type=positive_float, default=1.0, help="its grid step (the variables' unit)")
+    add_trade_off_options(p)
     p.set_defaults(func=run)
 
 
@@ -38,7 +40,9 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
     from mechopt.optimize.minimize import checked_options
     from mechopt.studies.runner import plan_study, run_study, study_options, summary_lines
 
-    study = load(args)
+    study = apply_trade_off(load(args), args)
+    if study.problem.trade_off and not args.dry_run:
+        return run_trade_off_command(study, args)
     args.method = args.method or study.method or DEFAULT_METHOD
     if args.budget is not None:
         check_budget(args.budget)

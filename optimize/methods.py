@@ -18,6 +18,7 @@ from mechopt.optimize import baselines as bl
 from mechopt.optimize.auto.plan import min_budget as auto_min_budget
 from mechopt.optimize.baselines.smt_ego import max_budget as ego_max_budget
 from mechopt.optimize.method_runs import MethodCall, run_auto, run_baseline, run_sparse, run_sparse_global
+from mechopt.optimize.objectives import MAX_OBJECTIVES
 from mechopt.optimize.options import Option, options_of
 from mechopt.optimize.result import OptimizeResult
 from mechopt.optimize.sparse.options import SparseOptions
@@ -146,7 +147,7 @@ def _own_records() -> list[Method]:
                "beyond, or Gauss-Newton runs from multi-level single linkage starts when the problem declares "
                "residuals; failed simulations learned and avoided", own=True, dims=(1, None), batches=True,
                min_budget=lambda dim, budget, n_lines: (auto_min_budget(dim), "2d + 2"), options=(),
-               starts_from_x0=True, compare_name="mechopt-auto"),
+               starts_from_x0=True, compare_name="mechopt-auto", max_objectives=MAX_OBJECTIVES),
         Method("sparse", run_sparse, "paper 002's line model: lines sampled, fitted by sums of exponentials, blended "
                "by Chebyshev interpolation, searched exhaustively, refined on the simulator (smooth landscapes)",
                own=True, dims=(2, 4), batches=True, min_budget=_sparse_min_budget, options=SparseOptions.DECLARED,

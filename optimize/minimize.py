@@ -18,7 +18,7 @@ from mechopt.optimize.analysis.robust_result import checked_robust, make_robust
 from mechopt.optimize.analysis.scatter import Tolerances
 from mechopt.optimize.arguments import check_budget, check_method, check_seed, check_workers, check_x0
 from mechopt.optimize.method_runs import MethodCall
-from mechopt.optimize.methods import DEFAULT_METHOD, check_options, get_method
+from mechopt.optimize.methods import AUTO_METHOD, DEFAULT_METHOD, check_options, get_method
 from mechopt.optimize.problem import DesignProblem
 from mechopt.optimize.result import OptimizeResult
 from mechopt.optimize.sparse.model_confidence import study_trust
@@ -26,6 +26,7 @@ from mechopt.optimize.sparse.options import SparseOptions
 from mechopt.optimize.sparse.sampler import Sampler
 from mechopt.optimize.sparse.space import ModelSpace
 from mechopt.optimize.sparse.validate import validate
+from mechopt.optimize.trade_off import check_trade_off_method, run_trade_off
 from mechopt.runs.executors import make_executor
 from mechopt.runs.store import SampleStore
 
@@ -42,6 +43,7 @@ def _check_arguments(problem: Any, budget: Any, method: Any, seed: Any, workers:
     check_workers(workers)
     if store is not None and not isinstance(store, str | os.PathLike | SampleStore):
         raise InputError(f"store = {store!r}: expected the path of an SQLite file or a SampleStore")
+    check_trade_off_method(problem, method)
     problem.check_region()
 
 
@@ -157,7 +159,7 @@ def _account(result: OptimizeResult, sampler: Sampler) -> None:
     result["nnew"], result["nreused"] = sampler.n_computed, sampler.n_cached
     result["nfailed"] = len(sampler.failures)
     result["failures"] = [(np.array(d, dtype=float), error) for d, error in sampler.failures.values()]
-    if result.success:
+    if result.success and np.ndim(result.x) == 1:
         record = sampler.records(np.asarray(result.x)[None, :], desc="optimum")[0]
         result["outputs"] = dict(record.outputs)
     elif result["failures"]:
@@ -240,6 +242,10 @@ def run_method(problem: DesignProblem, method: str | Callable[..., Any], opts: S
     OptimizeResult
         Without ``validation`` (held-out lines are the caller's choice).
     """
+    if method == AUTO_METHOD and problem.trade_off:
+        # Several objectives or limits on simulated outputs: x0 counts in the budget, as for the other plans.
+        return run_trade_off(problem, int(opts.budget) + (0 if x0 is None else len(x0)), int(opts.seed), sampler,
+                             initial=x0)
     record = get_method(method)
     call = MethodCall(problem, opts, sampler, log, record.name, dict(options or {}))
     if x0 is None:

@@ -33,6 +33,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from mechopt.errors import InputError, MechoptError
+from mechopt.optimize.objectives import Limits, ObjectiveSpec, parse_objective
 from mechopt.runs.fingerprint import fingerprint
 from mechopt.runs.sample_record import KEY_DECIMALS
 
@@ -142,8 +143,12 @@ class DesignProblem:
         Names of the columns of :meth:`margins`.
     outputs : tuple of str
         Names of the outputs :meth:`evaluate` must return (finite floats); it may return more keys.
-    objective : str
-        The output minimised.
+    objective : str or tuple of str
+        The output minimised, or 1 to 4 of them (a Pareto front); a leading ``-`` maximises an output
+        (:mod:`mechopt.optimize.objectives`).
+    limits : dict
+        ``{output: (lower, upper)}``, either bound None, in the output's unit: a simulated design outside is kept
+        in the store and infeasible in every answer.
     fit : str
         ``"square"`` (the model fits the objective squared, as T_RMS² for an RMS torque) or ``"value"``.
     output_units : dict
@@ -169,7 +174,8 @@ class DesignProblem:
     variables: tuple[Variable, ...] = ()
     constraints: tuple[str, ...] = ()
     outputs: tuple[str, ...] = ()
-    objective: str = ""
+    objective: str | tuple[str, ...] = ""
+    limits: dict[str, tuple[float | None, float | None]] = {}  # noqa: RUF012 - read-only class default
     fit: str = "value"
     output_units: dict[str, str] = {}  # noqa: RUF012 - read-only class default
     version: int = 1
@@ -350,8 +356,23 @@ class DesignProblem:
         return f"{name} ({unit})" if unit else name
 
     def objective_value(self, outputs: Mapping[str, float]) -> float:
-        """The objective from an evaluation's outputs."""
-        return float(outputs[self.objective])
+        """The (first) objective from an evaluation's outputs, as minimised (a maximised output negated)."""
+        return float(self.objective_spec.values(outputs)[0])
+
+    @property
+    def objective_spec(self) -> ObjectiveSpec:
+        """The objectives parsed: output names and senses (:func:`~mechopt.optimize.objectives.parse_objective`)."""
+        return parse_objective(self.objective, self.outputs, f"problem {self.name!r}")
+
+    @property
+    def limit_spec(self) -> Limits:
+        """The limits parsed (:meth:`~mechopt.optimize.objectives.Limits.parse`)."""
+        return Limits.parse(self.limits, self.outputs, f"problem {self.name!r}")
+
+    @property
+    def trade_off(self) -> bool:
+        """Several objectives or limits on simulated outputs: the method must see every output it reads."""
+        return self.objective_spec.k > 1 or self.limit_spec.m > 0
 
     def residual_vector(self, outputs: Mapping[str, Any]) -> np.ndarray:
         """The residual vector of an evaluation's outputs (a least-squares problem; :attr:`residuals`).
@@ -395,8 +416,10 @@ class DesignProblem:
             names = getattr(self, key)
             if isinstance(names, str) or not all(isinstance(n, str) for n in names):
                 raise InputError(f"{where}: {key} = {names!r}; expected a tuple of names such as ('f',)")
-        if not self.outputs or self.objective not in self.outputs:
-            raise InputError(f"{where}: objective {self.objective!r} must be one of outputs {list(self.outputs)}")
+        if not self.outputs:
+            raise InputError(f"{where}: outputs = {self.outputs!r}; expected the names the evaluator returns")
+        self.objective_spec  # noqa: B018 - parsing raises the one-line error
+        self.limit_spec  # noqa: B018
         if not isinstance(self.residuals, str) or (self.residuals and not self.residuals.isidentifier()):
             raise InputError(f"{where}: residuals = {self.residuals!r}; expected the name of an output or ''")
         if self.fit not in FITS:

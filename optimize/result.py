@@ -52,4 +52,13 @@ class OptimizeResult(_ScipyResult):
         Seconds of the method's own computing: the wall time of the run minus ``waiting_s``.
     wall_time_s : float
         Wall time of the call.
+
+    With several objectives (:mod:`mechopt.optimize.objectives`), ``x`` is (n, d) and ``fun`` (n, k): the
+    non-dominated simulated designs that meet every margin and limit, sorted by the first objective, each objective
+    as minimised (a maximised output negated); ``front_outputs`` holds every output of each, ``hypervolume`` the
+    hypervolume of the normalised front, ``reference_point`` its reference in objective units, ``normalisation``
+    the normalisation in one sentence and ``hypervolume_trace`` the hypervolume after each simulation
+    (:mod:`mechopt.optimize.pareto`).  With limits, ``feasible`` marks each returned design; a run where no design
+    meets them has ``success`` False and returns the designs that come closest.  ``simulated`` holds every design
+    of the run (``X``, ``F``, ``G``, ``ok``, ``feasible``).
     """

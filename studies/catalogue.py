@@ -202,6 +202,9 @@ def _load_cached(path_str: str, _mtime: int, options: tuple) -> Study:
 
             problem = with_simulator(file, problem)
         problem.check()
+        from mechopt.studies.trade_off_section import with_trade_off
+
+        problem = with_trade_off(file, problem)
     except StudyError:
         raise
     except MechoptError as exc:

@@ -97,8 +97,9 @@ class Sampler:
     def __call__(self, designs: np.ndarray, desc: str) -> np.ndarray:
         """The objective at designs (n, d); NaN where the simulation did not succeed."""
         records = self.records(designs, desc)
-        name = self.problem.objective
-        values = np.array([r.value(name) for r in records], dtype=float)
+        # The first objective, as minimised (a maximised output negated); NaN where the simulation did not succeed.
+        spec = self.problem.objective_spec
+        values = np.array([spec.senses[0] * r.value(spec.names[0]) for r in records], dtype=float)
         for d, v in zip(np.atleast_2d(np.asarray(designs, dtype=float)), values, strict=True):
             design = tuple(map(float, d))
             self.history[design_key(design)] = (design, float(v))

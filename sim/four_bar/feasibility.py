@@ -237,3 +237,11 @@ def constraint_margins(designs: np.ndarray, mechanism: FourBar) -> np.ndarray:
         report = check_feasibility(flat[valid], mechanism)
         out[valid] = np.nan_to_num(np.column_stack([getattr(report, c) for c in MARGIN_NAMES]), nan=-1e3)
     return out[0] if x.ndim == 1 else out
+
+
+def toggle_angle_deg(design: np.ndarray, mechanism: FourBar) -> float:
+    """The toggle margin of one design as a quantity: the least over the stroke of min(ζ, 180° − ζ), ζ the
+    crank–coupler angle at A (deg; 0 on the dead-centre line).  The constraint's margin ``toggle_deg`` is this
+    minus the mechanism's ``toggle_margin_deg``; NaN when the design cannot move through the stroke."""
+    report = check_feasibility(np.asarray(design, dtype=float)[None, :], mechanism)
+    return float(report.toggle_deg[0] + mechanism.toggle_margin_deg)

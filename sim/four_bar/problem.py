@@ -17,7 +17,13 @@ import numpy as np
 
 from mechopt.errors import InputError
 from mechopt.optimize.problem import DesignProblem, Variable
-from mechopt.sim.four_bar.feasibility import MARGIN_NAMES, N_CHECK, check_feasibility, constraint_margins
+from mechopt.sim.four_bar.feasibility import (
+    MARGIN_NAMES,
+    N_CHECK,
+    check_feasibility,
+    constraint_margins,
+    toggle_angle_deg,
+)
 from mechopt.sim.four_bar.mechanism import FourBar
 from mechopt.sim.four_bar.simulate import ENGINES, simulate
 
@@ -62,10 +68,10 @@ class FourBarProblem(DesignProblem):
     reconstruction: Any = None
 
     constraints = MARGIN_NAMES
-    outputs = ("t_rms", "t_max")
+    outputs = ("t_rms", "t_max", "toggle_margin_deg")
     objective = "t_rms"
     fit = "square"
-    output_units = {"t_rms": "N·m", "t_max": "N·m"}  # noqa: RUF012
+    output_units = {"t_rms": "N·m", "t_max": "N·m", "toggle_margin_deg": "deg"}  # noqa: RUF012
     # Paper 002 plans its lines over (|OA|, |BC|, |AB|): its Δ and origin are read in as printed.
     surrogate_order = (0, 2, 1)
 
@@ -87,11 +93,13 @@ class FourBarProblem(DesignProblem):
         return tuple(Variable(n, lo, hi, "mm", _LABELS[n]) for n, (lo, hi) in zip(_LABELS, self.box, strict=True))
 
     def evaluate(self, x: np.ndarray) -> dict[str, float]:
-        """T_RMS and T_max (N·m) of design ``x`` = (|OA|, |AB|, |BC|) in mm; raises InfeasibleDesignError if it
-        cannot be driven through the stroke."""
-        result = simulate(np.asarray(x, dtype=float), self.mechanism, engine=self.engine)
+        """T_RMS and T_max (N·m) and the toggle margin (deg: how far the crank-coupler angle at A stays from the
+        dead-centre line over the stroke, min of ζ and 180° − ζ) of design ``x`` = (|OA|, |AB|, |BC|) in mm; raises
+        InfeasibleDesignError if it cannot be driven through the stroke."""
+        x = np.asarray(x, dtype=float)
+        result = simulate(x, self.mechanism, engine=self.engine)
         return {"t_rms": float(result.t_rms), "t_max": float(result.t_max), "dt": float(result.dt),
-                "feasible": bool(result.feasible)}
+                "feasible": bool(result.feasible), "toggle_margin_deg": toggle_angle_deg(x, self.mechanism)}
 
     def evaluate_batch(self, X: np.ndarray) -> np.ndarray:
         """T_RMS (N·m) of many designs (n, 3) by the analytic engine (numba), for brute-force ground truths."""
