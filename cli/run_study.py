@@ -8,6 +8,7 @@ Everything a run produces goes to one folder: ``result.json`` (machine-readable)
 
 from __future__ import annotations
 
+import contextlib
 import os
 import time
 from collections.abc import Callable
@@ -30,7 +31,9 @@ from mechopt.optimize.sparse.options import SparseOptions
 from mechopt.optimize.sparse.sampler import Sampler
 from mechopt.optimize.sparse.space import ModelSpace
 from mechopt.optimize.sparse.validate import Validation, validate
+from mechopt.runs.early_stop import DEFAULT_STOP_AFTER_FAILURES
 from mechopt.runs.executors import check_reachable, default_workers, make_executor
+from mechopt.runs.run_watch import watch_run
 from mechopt.runs.store import SampleStore
 from mechopt.studies.catalogue import Study
 
@@ -85,7 +88,8 @@ def check_output_folder(out: Path) -> Path:
 def run_study(study: Study, out: Path, options: SparseOptions, workers: int | None = None,
               scheduler: str | None = None, store_path: Path | None = None, progress: bool = True,
               truth: bool = False, truth_step: float = 1.0, retry_failed: bool = False,
-              log: Callable[[str], None] = print, method: str = "sparse", x0: np.ndarray | None = None) -> StudyRun:
+              log: Callable[[str], None] = print, method: str = "sparse", x0: np.ndarray | None = None,
+              stop_after_failures: int = DEFAULT_STOP_AFTER_FAILURES) -> StudyRun:
     """Run the study end to end and write its outputs to ``out``.
 
     Parameters
@@ -115,6 +119,8 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
         available_methods`); held-out validation needs the line model of ``"sparse"``.
     x0 : (m, d) ndarray, optional
         Checked designs simulated first; they count in ``options.budget``, as in :func:`mechopt.minimize`.
+    stop_after_failures : int
+        Stop when the run's first this-many simulations all failed (0: never), as in :func:`mechopt.minimize`.
     """
     from mechopt.report.study_report import write_outputs
 
@@ -124,11 +130,15 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
     store_path = Path(store_path) if store_path else out / "samples.sqlite"
     timings: dict[str, float] = {}
     t_all = time.perf_counter()
-    with SampleStore(store_path) as store, make_executor(workers=workers, scheduler=scheduler) as executor:
+    with SampleStore(store_path) as store, make_executor(workers=workers, scheduler=scheduler) as executor, \
+            contextlib.ExitStack() as watching:
         sampler = Sampler(problem, store, executor, progress, retry_failed)
         plan = plan_run(study, options, method, store, executor.workers, retry_failed)
         for line in [*study_header(study), f"  store {store_path}, {sampler.executor_description}", *plan.text()]:
             log(line)
+        watching.enter_context(watch_run(sampler, plan.total, progress=progress,
+                                         stop_after_failures=stop_after_failures,
+                                         retry_hint="--retry-failed (retry_failed=True) simulates them again"))
         t0 = time.perf_counter()
         share = options if x0 is None else checked_options(problem, method, options, options.budget, options.seed, x0)
         result = run_method(problem, method, share, sampler, log, x0=x0)
@@ -151,6 +161,7 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
         sampling = {**sampler.summary(), "optimisation": n_opt, "validation": n_val,
                     "references": len(sampler.designs) - n_opt - n_val, "optimisation_timing": timing}
         failures = [(np.array(d), e) for d, e in sampler.failures.values()]
+        watching.close()  # the last progress line
     ground = _ground_truth(problem, out, truth, truth_step, timings)
     _line_model_verdict(result, validation, n_opt, log)
     result.update(validation=validation, outputs=references["optimum"]["outputs"])

@@ -69,7 +69,8 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
     # run_study checks the run (store, scheduler, feasible region) before it makes the output folder.
     run = run_study(study, out_arg, options, workers=args.workers, scheduler=args.scheduler, store_path=args.store,
                     progress=not args.no_progress, truth=args.truth, truth_step=args.truth_grid,
-                    retry_failed=args.retry_failed, method=args.method, x0=x0)
+                    retry_failed=args.retry_failed, method=args.method, x0=x0,
+                    stop_after_failures=args.stop_after_failures)
     print("\n".join(summary_lines(run)))
     print(f"report: {run.out / 'report.md'}")
     return 0

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from mechopt.errors import InfeasibleDesignError, InputError, MechoptError
+from mechopt.errors import BrokenSimulatorError, InfeasibleDesignError, InputError, MechoptError
 from mechopt.optimize.arguments import (
     AUTO_METHOD,
     DEFAULT_METHOD,
@@ -31,7 +31,9 @@ from mechopt.optimize.sparse.pipeline import run_pipeline
 from mechopt.optimize.sparse.sampler import Sampler
 from mechopt.optimize.sparse.space import ModelSpace
 from mechopt.optimize.sparse.validate import validate
+from mechopt.runs.early_stop import DEFAULT_STOP_AFTER_FAILURES, check_stop_after_failures
 from mechopt.runs.executors import make_executor
+from mechopt.runs.run_watch import watch_run
 from mechopt.runs.store import SampleStore
 
 __all__ = ["METHODS", "checked_options", "minimize", "parallel_accounting", "run_method"]
@@ -67,7 +69,8 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
              seed: int = 0, workers: int | None = 1, store: str | Path | SampleStore | None = None,
              options: Mapping[str, Any] | SparseOptions | None = None, scheduler: Any = None,
              progress: bool = False, retry_failed: bool = False,
-             log: Callable[[str], None] | None = None, x0: Any = None) -> OptimizeResult:
+             log: Callable[[str], None] | None = None, x0: Any = None,
+             stop_after_failures: int | None = DEFAULT_STOP_AFTER_FAILURES) -> OptimizeResult:
     """Minimise a design problem's objective within a budget of simulations.
 
     Parameters
@@ -103,7 +106,8 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
         ``workers`` is then how many designs run at once there: ``workers=None`` for every worker thread of the
         cluster (the default 1 runs one at a time).
     progress : bool
-        Progress bars with rate and ETA.
+        Progress bars with rate and ETA; when standard error is not a terminal (a log file, a pipe), one line at
+        each tenth of the budget and at least every 30 s instead.
     retry_failed : bool
         Simulate again designs whose earlier simulation failed.
     log : callable, optional
@@ -112,6 +116,10 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
         Designs to simulate first, in the variables' units: the current design, earlier candidates.  They count in
         the budget, the result is never worse than the best of them, and ``"auto"`` fits its model to them in place
         of as many of its space-filling designs.  Inside the bounds and satisfying the declared constraints.
+    stop_after_failures : int, optional
+        Stop the run, with the first failure's reason, when its first this-many simulations all failed (default 5;
+        with several workers the designs already running finish too); 0 or None never stops early.  Failures later
+        in a run do not stop it: the methods learn where the simulator fails and avoid it.
 
     Returns
     -------
@@ -125,8 +133,11 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
     ------
     InputError
         A bad argument, before any simulation.
+    BrokenSimulatorError
+        The first ``stop_after_failures`` simulations all failed.
     """
     _check_arguments(problem, budget, method, seed, workers, store)
+    stop_after_failures = check_stop_after_failures(stop_after_failures)
     X0 = check_x0(problem, x0, int(budget))
     opts = checked_options(problem, method, options, int(budget), int(seed), X0)
     log = log or (lambda _line: None)
@@ -135,11 +146,12 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
         db = _open_store(store, stack)
         executor = stack.enter_context(make_executor(workers=workers, scheduler=scheduler))
         sampler = Sampler(problem, db, executor, progress, retry_failed)
-        result = run_method(problem, method, opts, sampler, log, x0=X0)
-        if result.get("pipeline") is not None and opts.validation_lines > 0:  # not when handed to auto
-            result["validation"] = validate(result.model, ModelSpace(problem), sampler, opts.validation_lines,
-                                            opts.validation_points, opts.seed, f_min=result.fun)
-            result["trust"] = study_trust(result.stages[0], result.pipeline.best, result.validation)
+        with watch_run(sampler, int(budget), progress=progress, stop_after_failures=stop_after_failures):
+            result = run_method(problem, method, opts, sampler, log, x0=X0)
+            if result.get("pipeline") is not None and opts.validation_lines > 0:  # not when handed to auto
+                result["validation"] = validate(result.model, ModelSpace(problem), sampler, opts.validation_lines,
+                                                opts.validation_points, opts.seed, f_min=result.fun)
+                result["trust"] = study_trust(result.stages[0], result.pipeline.best, result.validation)
         _account(result, sampler)
     result["wall_time_s"] = time.perf_counter() - t0
     return result
@@ -275,7 +287,7 @@ def _sparse(problem: DesignProblem, opts: SparseOptions, sampler: Sampler, log: 
     try:
         pipeline = run_pipeline(space, opts, sampler, log=log)
     except MechoptError as exc:
-        if isinstance(exc, InputError) or not sampler.failures:
+        if isinstance(exc, InputError | BrokenSimulatorError) or not sampler.failures:
             raise
         return _handed_to_auto(problem, opts, sampler, f"the line model could not be built ({exc})", log)
     success = bool(np.isfinite(pipeline.fun) and space.feasible(pipeline.x)[0])
