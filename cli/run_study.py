@@ -138,7 +138,8 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
             log(line)
         watching.enter_context(watch_run(sampler, plan.total, progress=progress,
                                          stop_after_failures=stop_after_failures,
-                                         retry_hint="--retry-failed (retry_failed=True) simulates them again"))
+                                         retry_hint=f"--retry-failed (retry_failed=True) simulates them again "
+                                         f"(they are recorded in {store_path})"))
         t0 = time.perf_counter()
         share = options if x0 is None else checked_options(problem, method, options, options.budget, options.seed, x0)
         result = run_method(problem, method, share, sampler, log, x0=x0)

@@ -66,6 +66,7 @@ class ProgressLog:
         self.done = self.new = self.failed = 0
         self.best = math.inf
         self._tenth = 0
+        self._written = -1  # designs done at the last line
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._start = self._last = time.monotonic()
@@ -107,9 +108,12 @@ class ProgressLog:
         return (f"{self.label}: {self.done}/{self.planned} simulations ({100 * self.done / self.planned:.0f} %), "
                 f"best {self.objective} {best}, {self.failed} failed, {duration(now - self._start)} elapsed, {eta}")
 
-    def write(self) -> None:
-        """Write the progress line now."""
+    def write(self, unless_written: bool = False) -> None:
+        """Write the progress line now (with ``unless_written``, only if a design arrived since the last line)."""
         with self._lock:
+            if unless_written and self._written == self.done:
+                return
+            self._written = self.done
             stream = sys.stderr if self.stream is None else self.stream
             print(self.line(), file=stream, flush=True)
             self._last = time.monotonic()

@@ -50,7 +50,7 @@ def watch_run(sampler: Any, planned: int, *, progress: bool, stop_after_failures
             log.write()
         yield log
         if log is not None:
-            log.write()
+            log.write(unless_written=True)
     finally:
         if log is not None:
             log.close()

@@ -42,7 +42,7 @@ print(json.dumps(out))
 '''
 
 
-def write_study(folder: Path, kind: str, failure: str, monkeypatch) -> Path:
+def write_study(folder: Path, kind: str, failure: str) -> Path:
     """A study of kind "external" over a, b in [0, 4] whose simulator always fails the given way."""
     # The counter's path is written into the simulator: worker processes fork from a server started by an earlier
     # test, with that test's environment.
@@ -69,8 +69,8 @@ def calls(folder: Path) -> int:
 
 @pytest.mark.parametrize("kind", ["callable", "command"])
 @pytest.mark.parametrize("failure", sorted(FAILURES))
-def test_a_broken_simulator_stops_after_five_with_the_first_reason(tmp_path, monkeypatch, kind, failure):
-    problem = load_study(write_study(tmp_path, kind, failure, monkeypatch)).problem
+def test_a_broken_simulator_stops_after_five_with_the_first_reason(tmp_path, kind, failure):
+    problem = load_study(write_study(tmp_path, kind, failure)).problem
     with pytest.raises(BrokenSimulatorError) as info:
         mechopt.minimize(problem, budget=60, method="auto", seed=0, store=tmp_path / "s.sqlite")
     assert calls(tmp_path) == 5
@@ -79,9 +79,10 @@ def test_a_broken_simulator_stops_after_five_with_the_first_reason(tmp_path, mon
     assert FAILURES[failure][1] in message
 
 
-@pytest.mark.parametrize("method", ["auto", "sparse", "sparse-global", "differential_evolution", "nelder_mead", "optuna_tpe"])
-def test_every_method_through_the_sampler_stops_early(tmp_path, monkeypatch, method):
-    problem = load_study(write_study(tmp_path, "callable", "raises", monkeypatch)).problem
+@pytest.mark.parametrize("method", ["auto", "sparse", "sparse-global", "differential_evolution", "nelder_mead",
+                                    "optuna_tpe"])
+def test_every_method_through_the_sampler_stops_early(tmp_path, method):
+    problem = load_study(write_study(tmp_path, "callable", "raises")).problem
     with pytest.raises(BrokenSimulatorError, match="licence server not found"):
         mechopt.minimize(problem, budget=60, method=method, seed=0)
     assert calls(tmp_path) == 5
@@ -89,15 +90,15 @@ def test_every_method_through_the_sampler_stops_early(tmp_path, monkeypatch, met
 
 @pytest.mark.parametrize(("kind", "method"), [("callable", "auto"), ("command", "sparse"),
                                               ("callable", "differential_evolution")])
-def test_with_two_workers_at_most_five_plus_two(tmp_path, monkeypatch, kind, method):
-    problem = load_study(write_study(tmp_path, kind, "nan", monkeypatch)).problem
+def test_with_two_workers_at_most_five_plus_two(tmp_path, kind, method):
+    problem = load_study(write_study(tmp_path, kind, "nan")).problem
     with pytest.raises(BrokenSimulatorError):
         mechopt.minimize(problem, budget=60, method=method, seed=0, workers=2)
     assert 5 <= calls(tmp_path) <= 5 + 2
 
 
-def test_the_option_sets_k_and_zero_spends_the_budget(tmp_path, monkeypatch):
-    problem = load_study(write_study(tmp_path, "callable", "missing", monkeypatch)).problem
+def test_the_option_sets_k_and_zero_spends_the_budget(tmp_path):
+    problem = load_study(write_study(tmp_path, "callable", "missing")).problem
     with pytest.raises(BrokenSimulatorError, match="the first 3 simulations"):
         mechopt.minimize(problem, budget=20, seed=0, stop_after_failures=3)
     assert calls(tmp_path) == 3
@@ -125,8 +126,8 @@ def test_failures_after_a_success_stay_a_hidden_constraint(tmp_path):
     assert np.isfinite(result.fun)
 
 
-def test_mechopt_study_ends_in_one_line(tmp_path, monkeypatch, capsys):
-    toml = write_study(tmp_path, "command", "raises", monkeypatch)
+def test_mechopt_study_ends_in_one_line(tmp_path, capsys):
+    toml = write_study(tmp_path, "command", "raises")
     code = main(["study", str(toml), "--out", str(tmp_path / "out"), "--no-progress", "--workers", "1",
                  "--budget", "60", "--method", "auto"])
     err = capsys.readouterr().err.strip().splitlines()
