@@ -35,7 +35,9 @@ from mechopt.runs.early_stop import DEFAULT_STOP_AFTER_FAILURES
 from mechopt.runs.executors import check_reachable, default_workers, make_executor
 from mechopt.runs.run_watch import watch_run
 from mechopt.runs.store import SampleStore
+from mechopt.runs.store_path import check_store_folder
 from mechopt.studies.catalogue import Study
+from mechopt.studies.output_folder import check_output_owner
 
 __all__ = ["StudyRun", "check_output_folder", "check_run", "plan_study", "rounds_text", "run_study",
            "study_options", "summary_lines"]
@@ -89,7 +91,7 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
               scheduler: str | None = None, store_path: Path | None = None, progress: bool = True,
               truth: bool = False, truth_step: float = 1.0, retry_failed: bool = False,
               log: Callable[[str], None] = print, method: str = "sparse", x0: np.ndarray | None = None,
-              stop_after_failures: int = DEFAULT_STOP_AFTER_FAILURES) -> StudyRun:
+              stop_after_failures: int = DEFAULT_STOP_AFTER_FAILURES, force: bool = False) -> StudyRun:
     """Run the study end to end and write its outputs to ``out``.
 
     Parameters
@@ -121,11 +123,16 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
         Checked designs simulated first; they count in ``options.budget``, as in :func:`mechopt.minimize`.
     stop_after_failures : int
         Stop when the run's first this-many simulations all failed (0: never), as in :func:`mechopt.minimize`.
+    force : bool
+        Use ``out`` even when it holds another study's or another problem's results (they are removed first).
     """
     from mechopt.report.study_report import write_outputs
 
     problem = study.problem
     check_run(study, options, method, scheduler, store_path)
+    if store_path is not None:
+        check_store_folder(store_path)
+    check_output_owner(out, study.name, problem.fingerprint(), force)
     out = check_output_folder(out)
     store_path = Path(store_path) if store_path else out / "samples.sqlite"
     timings: dict[str, float] = {}

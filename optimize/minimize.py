@@ -35,6 +35,7 @@ from mechopt.runs.early_stop import DEFAULT_STOP_AFTER_FAILURES, check_stop_afte
 from mechopt.runs.executors import make_executor
 from mechopt.runs.run_watch import watch_run
 from mechopt.runs.store import SampleStore
+from mechopt.runs.store_path import check_store_folder
 
 __all__ = ["METHODS", "checked_options", "minimize", "parallel_accounting", "run_method"]
 
@@ -62,6 +63,8 @@ def _check_arguments(problem: Any, budget: Any, method: Any, seed: Any, workers:
     check_workers(workers)
     if store is not None and not isinstance(store, str | os.PathLike | SampleStore):
         raise InputError(f"store = {store!r}: expected the path of an SQLite file or a SampleStore")
+    if isinstance(store, str | os.PathLike):
+        check_store_folder(store, "store =")
     problem.check_region()
 
 
