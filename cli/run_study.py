@@ -38,6 +38,7 @@ from mechopt.runs.store import SampleStore
 from mechopt.runs.store_path import check_store_folder
 from mechopt.studies.catalogue import Study
 from mechopt.studies.output_folder import check_output_owner
+from mechopt.studies.reference_check import reference_warning
 
 __all__ = ["StudyRun", "check_output_folder", "check_run", "plan_study", "rounds_text", "run_study",
            "study_options", "summary_lines"]
@@ -314,7 +315,8 @@ def summary_lines(run: StudyRun) -> list[str]:
                      f"{problem.describe(np.array(run.truth.x))}, {obj} {run.truth.fun:.6g}; gap "
                      f"{100 * (run.result.fun / run.truth.fun - 1):+.2f} %")
     lines.append(_simulations_line(run))
-    return lines
+    warning = reference_warning(run.references, obj, float(run.result.fun), dict(problem.output_units).get(obj, ""))
+    return lines if warning is None else [*lines, warning]
 
 
 def _simulations_line(run: StudyRun) -> str:
