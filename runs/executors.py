@@ -35,7 +35,9 @@ from typing import Any, TypeVar
 from urllib.parse import urlsplit
 
 from mechopt.errors import InputError, StudyError
+from mechopt.runs.clean_termination import SigtermAsExit, Terminated
 from mechopt.runs.forkserver_main import MAIN_VARIABLE
+from mechopt.runs.main_guard import check_main_guard, leave_quietly_if_bootstrapping
 
 __all__ = [
     "DaskExecutor",
@@ -254,6 +256,8 @@ class ProcessExecutor(SampleExecutor):
     """
 
     def __init__(self, workers: int, *, prefetch: int = 0) -> None:
+        leave_quietly_if_bootstrapping()
+        check_main_guard(workers)
         self.workers = workers
         self.max_in_flight = workers + prefetch
         self.description = f"{workers} local process{'es' if workers != 1 else ''}"
@@ -263,6 +267,7 @@ class ProcessExecutor(SampleExecutor):
         # Start the workers now, in the background, while the method plans its first designs (issue 28: on a busy
         # machine a cold start of 8 workers took seconds, before the first simulation).
         threading.Thread(target=_warm_up, args=(self._pool, workers), name="mechopt-pool-warm-up", daemon=True).start()
+        self._sigterm = SigtermAsExit()
 
     def map_unordered(self, fn: Callable[[T], R], items: Iterable[T]) -> Iterator[R]:
         """Run ``fn`` over ``items`` in the worker processes (see :meth:`SampleExecutor.map_unordered`).
@@ -311,9 +316,10 @@ class ProcessExecutor(SampleExecutor):
         if self._pool is not None:
             self._pool.shutdown(wait=True, cancel_futures=True)
             self._pool = None
+            self._sigterm.restore()
 
     def __exit__(self, exc_type: type[BaseException] | None, *exc: object) -> None:
-        if exc_type is not None and issubclass(exc_type, KeyboardInterrupt):
+        if exc_type is not None and issubclass(exc_type, KeyboardInterrupt | Terminated):
             self._interrupt_workers()
         self.close()
 
