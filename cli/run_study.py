@@ -36,6 +36,7 @@ from mechopt.runs.executors import check_reachable, default_workers, make_execut
 from mechopt.runs.run_watch import watch_run
 from mechopt.runs.store import SampleStore
 from mechopt.runs.store_path import check_store_folder
+from mechopt.studies import method_cache
 from mechopt.studies.catalogue import Study
 from mechopt.studies.output_folder import check_output_owner
 from mechopt.studies.reference_check import reference_warning
@@ -150,7 +151,14 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
                                          f"(they are recorded in {store_path})"))
         t0 = time.perf_counter()
         share = options if x0 is None else checked_options(problem, method, options, options.budget, options.seed, x0)
-        result = run_method(problem, method, share, sampler, log, x0=x0)
+        key = method_cache.run_key(problem, method, share, x0, sampler.batch_size)
+        result = method_cache.replay(out, key, sampler)
+        if result is None:
+            result = run_method(problem, method, share, sampler, log, x0=x0)
+            method_cache.save(out, key, sampler, result)
+        else:
+            log(f"  {method}: every one of its {len(sampler.designs)} simulations is in the store, unchanged: its "
+                f"answer is replayed from {out / method_cache.CACHE_FILE}")
         timings["optimise_s"] = time.perf_counter() - t0
         n_opt = len(sampler.designs)
         timing = sampler.timing()

@@ -44,6 +44,8 @@ class Sampler:
             store.forget_failed(self.fingerprint)
         #: Canonical keys of the distinct designs this run asked for (float noise below 1e-9 is one design).
         self.designs: set[str] = set()
+        #: The same designs, by key, in the order first asked for.
+        self.asked: dict[str, tuple[float, ...]] = {}
         self.n_computed = 0
         self.n_cached = 0
         self.n_waited = 0
@@ -96,6 +98,7 @@ class Sampler:
         self.n_cached += max(0, first_time - res.n_computed - res.n_waited)
         for key, d, r in zip(keys, asked, res.records, strict=True):
             self.designs.add(key)
+            self.asked.setdefault(key, d)
             if r.status == "failed":
                 self.failures[key] = (d, r.error or "failed")
         return list(res.records)
