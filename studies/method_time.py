@@ -12,7 +12,7 @@ import functools
 import json
 from pathlib import Path
 
-__all__ = ["TABLE_FILE", "method_seconds", "table_source"]
+__all__ = ["TABLE_FILE", "method_seconds", "method_time_line", "table_source"]
 
 #: The measured table (written by ``benchmarks/bench_method_time.py``).
 TABLE_FILE = Path(__file__).with_name("method_time.json")
@@ -63,3 +63,17 @@ def method_seconds(method: str, dim: int, budget: int) -> float | None:
         if b0 <= budget <= b1:
             return s0 + (s1 - s0) * (budget - b0) / (b1 - b0)
     return None
+
+
+def _duration(seconds: float) -> str:
+    return f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min" if seconds < 7200 else \
+        f"{seconds / 3600:.1f} h"
+
+
+def method_time_line(method_s: float | None, simulation_s: float | None) -> str:
+    """The plan's line on the method's own computing, and the run's expected wall time with it."""
+    if method_s is None:
+        return "  the method's own computing: not measured for this method (benchmarks/bench_method_time.py)"
+    total = "" if simulation_s is None else f"; expected wall time about {_duration(method_s + simulation_s)} in all"
+    return (f"  the method's own computing: about {_duration(method_s)} ({table_source()}, "
+            f"benchmarks/bench_method_time.py; a re-run whose simulations are all stored replays its answer){total}")
