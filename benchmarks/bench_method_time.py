@@ -55,24 +55,31 @@ def main() -> None:
     parser.add_argument("--seeds", nargs="+", type=int, default=[0, 1])
     parser.add_argument("--no-write", action="store_true", help=f"print only; do not write {TABLE_FILE.name}")
     args = parser.parse_args()
-    rows = []
+    rows: list[dict] = []
     start = time.perf_counter()
-    for method in args.methods:
+    # Every method at the smallest budget first: a long run stopped early still has a row for each.
+    for budget in args.budgets:
         for dim in args.dims:
-            for budget in args.budgets:
+            for method in args.methods:
                 seconds = method_seconds(method, dim, budget, args.seeds)
                 if seconds is None:
                     continue
                 rows.append({"method": method, "dim": dim, "budget": budget, "seconds": round(seconds, 3)})
                 print(f"{method:24s} d={dim}  budget {budget:4d}: {seconds:8.2f} s of its own computing", flush=True)
+                if not args.no_write:  # after each row, so that a stopped run keeps what it measured
+                    write_table(rows, args.seeds)
+    print(f"{len(rows)} rows in {time.perf_counter() - start:.0f} s; " +
+          ("not written" if args.no_write else f"written: {TABLE_FILE}"))
+
+
+def write_table(rows: list[dict], seeds: list[int]) -> None:
+    """The table as :mod:`mechopt.studies.method_time` reads it, with its command, date and machine."""
     table = {"command": "python benchmarks/bench_method_time.py " + " ".join(sys.argv[1:]),
              "date": datetime.date.today().isoformat(), "cores": os.cpu_count(),
+             "load_average_1min": round(os.getloadavg()[0], 1),
              "note": "median over seeds of minimize(...)['method_s'], in-process, on a function costing microseconds",
-             "seeds": args.seeds, "rows": rows}
-    print(f"{len(rows)} rows in {time.perf_counter() - start:.0f} s")
-    if not args.no_write:
-        TABLE_FILE.write_text(json.dumps(table, indent=1) + "\n")
-        print(f"written: {TABLE_FILE}")
+             "seeds": seeds, "rows": rows}
+    TABLE_FILE.write_text(json.dumps(table, indent=1) + "\n")
 
 
 if __name__ == "__main__":
