@@ -36,7 +36,7 @@ METHODS = ("auto", "sparse", "sparse-global", "differential_evolution", "nelder_
 
 def method_seconds(method: str, dim: int, budget: int, seeds: list[int]) -> float | None:
     """Median over ``seeds`` of the method's own seconds on the dimension's function; None where it does not run."""
-    if method == "sparse" and dim > 4:
+    if method in ("sparse", "sparse-global") and dim > 4:
         return None
     times = []
     for seed in seeds:
