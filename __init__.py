@@ -17,7 +17,11 @@ Public API (flat, as scipy.optimize and pymunk):
   :class:`InfeasibleDesignError`.
 
 Subpackages: :mod:`mechopt.sim` (the physics: one folder per mechanism), :mod:`mechopt.surrogate` (the mathematics,
-independent of the physics) and :mod:`mechopt.studies` (the engine that runs a study, and the shipped studies).
+independent of the physics), :mod:`mechopt.optimize` (the problem protocol, the table of methods and the methods),
+:mod:`mechopt.runs` (the sample store, claims and executors), :mod:`mechopt.studies` (the shipped studies, the
+study-file loader, the runner of a whole study, its plan and the optimizer comparison), :mod:`mechopt.report` (what
+a run leaves for a person: result.json, report.md, figures) and :mod:`mechopt.cli` (the command line: it parses,
+calls the library and prints).
 """
 
 # pytest imports the checkout's root __init__.py as a plain file (no parent package) when the clone's folder name is

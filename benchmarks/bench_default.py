@@ -33,6 +33,7 @@ if __package__ in (None, ""):
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from mechopt import minimize  # noqa: E402
+from mechopt.optimize.methods import DEFAULT_METHOD  # noqa: E402
 from mechopt.studies.benchmark_functions import SUITE, TestFunction  # noqa: E402
 
 #: Peers named by the issue: SMT EGO at small budgets, the library optimisers at large ones.
@@ -91,7 +92,7 @@ def table(path: Path, methods: list[str] | None = None) -> None:
     cells: dict[tuple, list[dict]] = {}
     for r in rows:
         cells.setdefault((r["dim"], r["function"], r["budget"]), []).append(r)
-    methods = methods or sorted({r["method"] for r in rows}, key=lambda m: (m != "auto", m))
+    methods = methods or sorted({r["method"] for r in rows}, key=lambda m: (m != DEFAULT_METHOD, m))
     print("median gap % of range | median best value | seeds in the global basin / seeds | median s/run; "
           "'raised' counts runs that raised")
     print(f"{'function':18s} {'d':>2s} {'budget':>6s} " + " ".join(f"{m:>34s}" for m in methods))

@@ -17,7 +17,8 @@ import time
 import numpy as np
 
 from mechopt.errors import InfeasibleDesignError
-from mechopt.optimize.baselines import BASELINES, CountedProblem
+from mechopt.optimize.baselines import CountedProblem
+from mechopt.optimize.methods import METHODS
 from mechopt.sim.four_bar.analytic import simulate_analytic
 from mechopt.sim.four_bar.feasibility import check_feasibility
 from mechopt.studies.catalogue import load_study
@@ -65,7 +66,7 @@ def main() -> None:
             for seed in range(args.seeds):
                 problem, mechanism = ventilator_problem(budget)
                 t0 = time.perf_counter()
-                res = BASELINES[name](problem, seed)
+                res = METHODS[name].function(problem, seed)
                 walls.append(time.perf_counter() - t0)
                 calls.append(int(res.nfev))
                 t = true_t_rms(res.x if res.success else None, mechanism)

@@ -37,6 +37,7 @@ if __package__ in (None, ""):
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from mechopt import minimize  # noqa: E402
+from mechopt.optimize.methods import METHODS  # noqa: E402
 from mechopt.optimize.minimize import _options, run_method  # noqa: E402
 from mechopt.optimize.sparse.sampler import Sampler  # noqa: E402
 from mechopt.runs.executors import InProcessExecutor  # noqa: E402
@@ -140,7 +141,7 @@ def run_timed(args: argparse.Namespace, folder: Path) -> list[dict]:
     for name in args.functions:
         dim = SUITE[name]().dim
         for method in args.methods:
-            if method != "auto" and dim > 4:
+            if not METHODS[method].takes_dim(dim):
                 continue  # the line methods take 2 to 4 variables
             for budget in args.budgets:
                 for workers in args.workers:
@@ -170,7 +171,7 @@ def run_answers(args: argparse.Namespace) -> None:
     print("|---|---|---:|---:|---:|---:|---:|")
     for name in args.functions:
         for method in args.methods:
-            if method != "auto" and SUITE[name]().dim > 4:
+            if not METHODS[method].takes_dim(SUITE[name]().dim):
                 continue
             for budget in args.answer_budgets:
                 base = None

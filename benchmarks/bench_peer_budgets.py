@@ -5,9 +5,9 @@ Each peer (Optuna TPE and CMA-ES, pymoo GA, PSO and DE, nevergrad NGOpt and CMA,
 points (d, budget) = (3, 30), (3, 300), (6, 300), (8, 500), (12, 1000): Hartmann-3, Hartmann-6, Levy-8 and, since
 the suite has no 12-D function, Levy in 12-D defined here (Laguna & Martí 2005; global 0 at (1, ..., 1) on
 [-10, 10]^12).  A suite function that the installed mechopt does not have is replaced by Levy of the same dimension.
-SMT EGO runs only within its limit in ``mechopt compare`` (:func:`mechopt.cli.compare.ego_max_budget`): at (3, 30)
-and at (3, limit) and (8, limit), where the time of its last steps is what the limit rests on (a step's cost grows
-with the cube of the samples and with the dimension).
+SMT EGO runs only within its limit in ``mechopt compare`` (:func:`mechopt.optimize.baselines.smt_ego.max_budget`):
+at (3, 30) and at (3, limit) and (8, limit), where the time of its last steps is what the limit rests on (a step's
+cost grows with the cube of the samples and with the dimension).
 
 Printed: a Markdown table, one row per peer and point: simulations spent / budget, wall and CPU time of the run
 (CPU: this process's, which BLAS threads limited to one makes the time of the run on an idle core), and the
@@ -27,8 +27,8 @@ from dataclasses import dataclass
 import numpy as np
 
 import mechopt
-from mechopt.cli.compare import ego_max_budget
-from mechopt.optimize.baselines import BASELINES, LIBRARY_BASELINES
+from mechopt.optimize.baselines.smt_ego import max_budget as ego_max_budget
+from mechopt.optimize.methods import METHODS
 from mechopt.optimize.problem import Variable
 from mechopt.studies.benchmark_functions import SUITE, TestFunction
 
@@ -108,19 +108,21 @@ def run(peer: str, d: int, budget: int, name: str) -> tuple[dict, list[tuple[flo
 def main() -> int:
     """Run every peer at every point; print the table and EGO's step times; exit 1 if a run stopped short."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--peers", default=",".join(LIBRARY_BASELINES), help="comma-separated library peers")
+    library = [name for name, m in METHODS.items() if m.spends_whole_budget]
+    parser.add_argument("--peers", default=",".join(library), help="comma-separated library peers")
     parser.add_argument("--no-ego-limit", action="store_true", help="skip EGO's runs at its limit (the slow ones)")
     args = parser.parse_args()
     peers = [p for p in args.peers.split(",") if p]
-    unknown = [p for p in peers if p not in BASELINES]
+    unknown = [p for p in peers if p not in METHODS or METHODS[p].own]
     if unknown:
-        parser.error(f"unknown peer {unknown[0]!r}; expected some of {', '.join(LIBRARY_BASELINES)}")
+        parser.error(f"unknown peer {unknown[0]!r}; expected some of {', '.join(library)}")
     print("| peer | d | budget | function | simulations spent | wall (s) | CPU (s) | note |")
     print("|---|---|---|---|---|---|---|---|")
     short, ego_steps = 0, {}
     for peer in peers:
         points = POINTS
-        if peer == "smt_ego":
+        capped = METHODS[peer].max_budget is not None  # SMT's EGO: its steps refit Kriging on every sample
+        if capped:
             points = [p for p in POINTS if p[1] <= ego_max_budget(p[0])]
             if not args.no_ego_limit:
                 points += [(3, ego_max_budget(3), "hartmann3"), (8, ego_max_budget(8), "levy8")]
@@ -133,7 +135,7 @@ def main() -> int:
                 note = row["message"]
             print(f"| {peer} | {d} | {budget} | {row['function']} | {row['nfev']} / {budget} | {row['wall_s']:.1f} | "
                   f"{row['cpu_s']:.1f} | {note} |", flush=True)
-            if peer == "smt_ego" and len(stamps) > 6:
+            if capped and len(stamps) > 6:
                 wall = np.diff([s[0] for s in stamps])
                 cpu = np.diff([s[1] for s in stamps])
                 ego_steps[(d, budget)] = (float(np.mean(wall[-5:])), float(np.mean(cpu[-5:])))

@@ -17,7 +17,6 @@ from pathlib import Path
 
 import numpy as np
 
-from mechopt.cli.run_study import study_options
 from mechopt.optimize.ground_truth import load_or_compute
 from mechopt.optimize.sparse.sampler import Sampler
 from mechopt.optimize.sparse.space import ModelSpace
@@ -25,6 +24,7 @@ from mechopt.optimize.sparse.stage import build_stage
 from mechopt.optimize.sparse.validate import validate
 from mechopt.runs.store import SampleStore
 from mechopt.studies.catalogue import load_study
+from mechopt.studies.runner import study_options
 
 #: (label, options changed from the study's defaults, the toggle relaxation of the lines in degrees)
 CONFIGS = [

@@ -12,7 +12,8 @@ import argparse
 import json
 from pathlib import Path
 
-from mechopt.cli.compare import headline, plot_headline
+from mechopt.report.comparison_figures import plot_headline
+from mechopt.studies.comparison import headline
 
 
 def main() -> None:

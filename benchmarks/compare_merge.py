@@ -15,8 +15,8 @@ import argparse
 import json
 from pathlib import Path
 
-from mechopt.cli import compare as cmp
 from mechopt.optimize.ground_truth import GroundTruth
+from mechopt.studies import comparison as cmp
 from mechopt.studies.catalogue import load_study
 
 

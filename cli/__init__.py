@@ -1,2 +1,2 @@
-"""The ``mechopt`` command line: ``main.py`` parses and dispatches, ``run_study.py`` runs a whole study,
-``compare.py`` runs optimizers side by side at equal budgets."""
+"""The ``mechopt`` command line: ``main.py`` parses and dispatches to one module per command, each of which parses
+its arguments, calls the library (:mod:`mechopt.studies.runner`, :mod:`mechopt.studies.comparison`) and prints."""

@@ -1,5 +1,6 @@
 """Commands on what mechopt ships: ``mechopt studies`` (the studies and test functions, one line each),
-``mechopt methods`` (the optimizers ``--method`` accepts) and ``mechopt init`` (copy a study to start one's own)."""
+``mechopt methods`` (the optimizers ``--method`` accepts, with their options) and ``mechopt init`` (copy a study to
+start one's own)."""
 
 from __future__ import annotations
 
@@ -13,24 +14,12 @@ from mechopt.errors import InputError
 
 __all__ = ["add_parsers", "method_lines", "run_init", "run_methods", "run_studies", "study_lines"]
 
-#: One line for each line-model method (the baselines carry theirs in ``BASELINE_DOCS``).
-_SPARSE_DOCS = {
-    "auto": "the default (and of every study that names none): Gaussian-process steps (Matern-5/2, expected "
-    "improvement): one global model up to 300 designs, restarted trust regions beyond, "
-    "or Gauss-Newton runs from multi-level single linkage starts when the problem declares residuals; failed "
-    "simulations learned and avoided (budget >= 2d + 2).",
-    "sparse": "paper 002's line model: lines sampled, fitted by sums of exponentials, blended by Chebyshev "
-    "interpolation, searched exhaustively, refined on the simulator (2 to 4 variables; smooth landscapes).",
-    "sparse-global": "the same lines and blend made global on multimodal landscapes: basins of the blend simulated, "
-    "then steps on the blend corrected by every simulation (2 to 4 variables).",
-}
-
-
 def add_parsers(sub) -> None:
     """Add ``studies``, ``methods`` and ``init`` to the subcommands."""
     p = sub.add_parser("studies", help="list the packaged studies and test functions, one line each")
     p.set_defaults(func=run_studies)
-    p = sub.add_parser("methods", help="list the optimizers `--method` accepts, one line each")
+    p = sub.add_parser("methods", help="list the optimizers `--method` accepts, with what each takes and its options")
+    p.add_argument("name", nargs="?", metavar="METHOD", help="only this method")
     p.set_defaults(func=run_methods)
     p = sub.add_parser("init", help="copy a packaged study (its TOML and data) to start a study of your own")
     p.add_argument("name", help="the packaged study to copy (e.g. ventilator)")
@@ -59,15 +48,12 @@ def study_lines() -> list[str]:
     return [f"{name:<{width}}  {what}: {text}" for name, what, text in rows]
 
 
-def method_lines() -> list[str]:
-    """``name  description`` for every method of :func:`mechopt.minimize`."""
-    from mechopt.optimize.arguments import available_methods
-    from mechopt.optimize.baselines import BASELINE_DOCS
+def method_lines(name: str | None = None) -> list[str]:
+    """Every method of :func:`mechopt.minimize` (or only ``name``): a line with its name and summary, then what it
+    takes and its options with their defaults, indented (:func:`mechopt.optimize.methods.show_options`)."""
+    from mechopt.optimize.methods import show_options
 
-    docs = {**_SPARSE_DOCS, **BASELINE_DOCS}
-    names = available_methods()
-    width = max(map(len, names))
-    return [f"{name:<{width}}  {docs.get(name, '')}" for name in names]
+    return show_options(name).splitlines()
 
 
 def run_studies(args: argparse.Namespace, rest: list[str]) -> int:
@@ -79,7 +65,7 @@ def run_studies(args: argparse.Namespace, rest: list[str]) -> int:
 
 def run_methods(args: argparse.Namespace, rest: list[str]) -> int:
     """Print the methods."""
-    print("\n".join(method_lines()))
+    print("\n".join(method_lines(args.name)))
     print("\nchoose one with `mechopt study NAME --method METHOD` or `mechopt.minimize(problem, method=...)`")
     return 0
 

@@ -49,9 +49,9 @@ def _studies(args: argparse.Namespace, names: list[str]) -> list:
 
 def run(args: argparse.Namespace, rest: list[str]) -> int:
     """Run every method at every budget and seed on every study; write the tables and figures."""
-    from mechopt.cli import compare as cmp
-    from mechopt.cli.run_study import check_output_folder
     from mechopt.optimize.ground_truth import load_or_compute
+    from mechopt.studies import comparison as cmp
+    from mechopt.studies.runner import check_output_folder
 
     names = [n for n in study_name(args).split(",") if n]
     methods = cmp.method_names(args.methods)
@@ -76,9 +76,7 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
         budgets[study.name] = cmp.largest_budgets(rows)
         unfinished[study.name] = cmp.unfinished_methods(rows)
     if len(studies) > 1:
-        text = cmp.headline(needed, budgets, unfinished)
-        (base / "headline.md").write_text(text)
-        fig = cmp.plot_headline(needed, budgets, base / "figures" / "compare_headline.png", unfinished)
+        text, md, fig = cmp.write_headline(needed, budgets, base, unfinished)
         print(text)
-        print(f"headline written to {base / 'headline.md'}, figure to {fig}")
+        print(f"headline written to {md}, figure to {fig}")
     return 0

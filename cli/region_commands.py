@@ -47,8 +47,8 @@ def _marks(study, out: Path) -> dict[str, np.ndarray]:
 
 def run_feasible(args: argparse.Namespace, rest: list[str]) -> int:
     """Draw the feasible region (slices; the 3-D view for 3 variables) and print each design's margins."""
-    from mechopt.cli.run_study import check_output_folder
     from mechopt.report.plots import plot_feasible_3d, plot_feasible_slices
+    from mechopt.studies.runner import check_output_folder
 
     study = load(args)
     problem = study.problem
@@ -74,8 +74,8 @@ def run_feasible(args: argparse.Namespace, rest: list[str]) -> int:
 
 def run_truth(args: argparse.Namespace, rest: list[str]) -> int:
     """Brute-force the study's optimum (cached in the output folder) and print it."""
-    from mechopt.cli.run_study import check_output_folder
     from mechopt.optimize.ground_truth import batch_evaluator, load_or_compute
+    from mechopt.studies.runner import check_output_folder
 
     study = load(args)
     batch_evaluator(study.problem)  # refused before the output folder is made

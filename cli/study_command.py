@@ -36,9 +36,9 @@ def add_parser(sub, engines: tuple[str, ...]) -> None:
 
 def run(args: argparse.Namespace, rest: list[str]) -> int:
     """Run the study named on the command line and print its summary."""
-    from mechopt.cli.run_study import plan_study, run_study, study_options, summary_lines
     from mechopt.optimize.arguments import DEFAULT_METHOD, check_budget, check_method, check_x0
     from mechopt.optimize.minimize import checked_options
+    from mechopt.studies.runner import plan_study, run_study, study_options, summary_lines
 
     study = load(args)
     args.method = args.method or study.method or DEFAULT_METHOD
@@ -63,7 +63,7 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
         store = Path(args.store) if args.store else out_arg / "samples.sqlite"
         plan = plan_study(study, options, workers=args.workers, scheduler=args.scheduler, store_path=store,
                           retry_failed=args.retry_failed, method=args.method)
-        from mechopt.cli.study_header import study_header
+        from mechopt.studies.run_header import study_header
 
         print("\n".join([*study_header(study), f"  store {store}", *plan.text()]))
         print("dry run: nothing simulated")

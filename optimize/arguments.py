@@ -3,37 +3,15 @@ with the same one-line message, before any simulation."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
 from mechopt.errors import InputError
+from mechopt.optimize.methods import AUTO_METHOD, DEFAULT_METHOD, MIN_BUDGET, available_methods, get_method
 
-__all__ = ["AUTO_METHOD", "MIN_BUDGET", "SPARSE_METHODS", "available_methods", "check_budget", "check_method",
+__all__ = ["AUTO_METHOD", "DEFAULT_METHOD", "MIN_BUDGET", "available_methods", "check_budget", "check_method",
            "check_seed", "check_workers", "check_x0", "handles_dim", "method_min_budget"]
-
-#: The fewest simulations any method is given: a model needs a few designs before it can propose one.
-MIN_BUDGET = 3
-
-#: The line-model methods of paper 002 (``mechopt.optimize.sparse`` and ``mechopt.optimize.sparse_global``).
-SPARSE_METHODS = ("sparse", "sparse-global")
-
-#: The default method of :func:`mechopt.minimize` (:mod:`mechopt.optimize.auto`): its plan follows d and the budget.
-AUTO_METHOD = "auto"
-#: The method of :func:`mechopt.minimize` and of a study that names none.
-DEFAULT_METHOD = AUTO_METHOD
-
-
-def _baselines() -> dict[str, Callable[..., Any]]:
-    from mechopt.optimize.baselines import BASELINES
-
-    return BASELINES
-
-
-def available_methods() -> list[str]:
-    """Every method name :func:`mechopt.minimize` and ``mechopt study --method`` accept."""
-    return [AUTO_METHOD, *SPARSE_METHODS, *_baselines()]
 
 
 def _whole(value: Any) -> bool:
@@ -99,8 +77,9 @@ def check_x0(problem: Any, x0: Any, budget: int) -> np.ndarray | None:
 
 def check_method(method: Any, dim: int, name: str = "the problem", budget: int | None = None,
                  n_lines: int | None = None) -> None:
-    """Refuse an unknown method name, a line-model method outside its 2 to 4 design variables, or a budget below
-    the method's own minimum (:func:`method_min_budget`).
+    """Refuse an unknown method name, a method outside the dimensions it takes, or a budget below the method's own
+    minimum (:func:`method_min_budget`); each as read from the table of methods
+    (:data:`mechopt.optimize.methods.METHODS`).
 
     Parameters
     ----------
@@ -118,11 +97,10 @@ def check_method(method: Any, dim: int, name: str = "the problem", budget: int |
     """
     if callable(method):
         return
-    if method not in available_methods():
-        raise InputError(f"method = {method!r}; expected one of {', '.join(available_methods())} or a callable")
-    if not handles_dim(method, dim):
-        raise InputError(f"method {method!r} handles 2 to 4 design variables; {name!r} has {dim}: choose 'auto' "
-                         "or a baseline (`--method`, `mechopt methods`)")
+    record = get_method(method)
+    if not record.takes_dim(dim):
+        raise InputError(f"method {method!r} handles {record.dims_text()} design variables; {name!r} has {dim}: "
+                         f"choose {DEFAULT_METHOD!r} or a baseline (`--method`, `mechopt methods`)")
     if budget is None:
         return
     need, why = method_min_budget(method, dim, budget, n_lines)
@@ -132,25 +110,12 @@ def check_method(method: Any, dim: int, name: str = "the problem", budget: int |
 
 
 def handles_dim(method: str, dim: int) -> bool:
-    """Whether a method takes ``dim`` design variables: the line models 2 to 4, every other method any number."""
-    return method not in SPARSE_METHODS or 2 <= dim <= 4
+    """Whether a method takes ``dim`` design variables (the line models 2 to 4, every other method any number)."""
+    return get_method(method).takes_dim(dim)
 
 
 def method_min_budget(method: str, dim: int, budget: int = MIN_BUDGET, n_lines: int | None = None) -> tuple[int, str]:
-    """The fewest simulations a mechopt method is given for ``dim`` variables, and the rule in words.
-
-    ``auto`` needs 2d + 2 (its Sobol design and a model step); ``sparse`` two samples on each line of its global
-    model and one to confirm the model's candidate (lines: ``n_lines``, or the plan scaled to ``budget``), since a
-    line plan trimmed to fewer would run past the budget; ``sparse-global`` 10·d (its lines and the steps on them).
-    A baseline needs :data:`MIN_BUDGET`.
-    """
-    if method == AUTO_METHOD:
-        return 2 * dim + 2, "2d + 2"
-    if method == "sparse":
-        from mechopt.optimize.sparse.options import SparseOptions
-
-        lines = int(n_lines) if n_lines is not None else SparseOptions.for_budget(budget, dim).n_lines
-        return 2 * lines + 1, f"2 samples on each of its {lines} lines + 1"
-    if method == "sparse-global":
-        return 10 * dim, "10d"
-    return MIN_BUDGET, str(MIN_BUDGET)
+    """The fewest simulations a method is given for ``dim`` variables, and the rule in words (its record's
+    ``min_budget``): ``auto`` 2d + 2, ``sparse`` two samples on each line of its global model (``n_lines``, or the
+    plan scaled to ``budget``) and one to confirm, ``sparse-global`` 10·d, a baseline :data:`MIN_BUDGET`."""
+    return get_method(method).min_budget(dim, budget, n_lines)

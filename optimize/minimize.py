@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import os
 import tempfile
 import time
@@ -12,22 +13,14 @@ from typing import Any
 
 import numpy as np
 
-from mechopt.errors import BrokenSimulatorError, InfeasibleDesignError, InputError, MechoptError
-from mechopt.optimize.arguments import (
-    AUTO_METHOD,
-    DEFAULT_METHOD,
-    SPARSE_METHODS,
-    check_budget,
-    check_method,
-    check_seed,
-    check_workers,
-    check_x0,
-)
+from mechopt.errors import InputError
+from mechopt.optimize.arguments import check_budget, check_method, check_seed, check_workers, check_x0
+from mechopt.optimize.method_runs import MethodCall
+from mechopt.optimize.methods import DEFAULT_METHOD, check_options, get_method
 from mechopt.optimize.problem import DesignProblem
 from mechopt.optimize.result import OptimizeResult
 from mechopt.optimize.sparse.model_confidence import study_trust
 from mechopt.optimize.sparse.options import SparseOptions
-from mechopt.optimize.sparse.pipeline import run_pipeline
 from mechopt.optimize.sparse.sampler import Sampler
 from mechopt.optimize.sparse.space import ModelSpace
 from mechopt.optimize.sparse.validate import validate
@@ -37,20 +30,7 @@ from mechopt.runs.run_watch import watch_run
 from mechopt.runs.store import SampleStore
 from mechopt.runs.store_path import check_store_folder
 
-__all__ = ["METHODS", "checked_options", "minimize", "parallel_accounting", "run_method"]
-
-#: ``"sparse"``: the pipeline of paper 002 (global model, confirmation, local refinement) — for smooth landscapes;
-#: ``"sparse-global"``: the same lines and blend made global on multimodal ones (basins of the blend and of its
-#: leave-one-line-out uncertainty simulated, then steps on the blend corrected by every simulation;
-#: :mod:`mechopt.optimize.sparse_global`).  Every
-#: name of :data:`mechopt.optimize.baselines.BASELINES` is a method too.
-METHODS = SPARSE_METHODS
-
-
-def _baselines() -> dict[str, Callable[..., Any]]:
-    from mechopt.optimize.baselines import BASELINES
-
-    return BASELINES
+__all__ = ["checked_options", "minimize", "parallel_accounting", "run_method"]
 
 
 def _check_arguments(problem: Any, budget: Any, method: Any, seed: Any, workers: Any, store: Any) -> None:
@@ -102,8 +82,8 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
         SQLite sample store: designs found there (same problem fingerprint) are not simulated again, and every new
         one is committed as soon as it is known.  Default: a temporary store, discarded at the end.
     options : mapping or SparseOptions, optional
-        Options of the sparse method (``SparseOptions.help()``); defaults are scaled to the budget.
-        ``validation_lines`` defaults to 0 here (no held-out lines).
+        The method's options (``mechopt methods NAME``); an unknown one is refused.  The sparse method's are scaled
+        to the budget, and its ``validation_lines`` defaults to 0 here (no held-out lines).
     scheduler : str, optional
         A Dask scheduler address (or a client, or a ``LocalCluster``) to evaluate on instead of local processes;
         ``workers`` is then how many designs run at once there: ``workers=None`` for every worker thread of the
@@ -142,7 +122,7 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
     _check_arguments(problem, budget, method, seed, workers, store)
     stop_after_failures = check_stop_after_failures(stop_after_failures)
     X0 = check_x0(problem, x0, int(budget))
-    opts = checked_options(problem, method, options, int(budget), int(seed), X0)
+    opts, own = _split_options(problem, method, options, int(budget), int(seed), X0)
     log = log or (lambda _line: None)
     t0 = time.perf_counter()
     with contextlib.ExitStack() as stack:
@@ -150,7 +130,7 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
         executor = stack.enter_context(make_executor(workers=workers, scheduler=scheduler))
         sampler = Sampler(problem, db, executor, progress, retry_failed)
         with watch_run(sampler, int(budget), progress=progress, stop_after_failures=stop_after_failures):
-            result = run_method(problem, method, opts, sampler, log, x0=X0)
+            result = run_method(problem, method, opts, sampler, log, x0=X0, options=own)
             if result.get("pipeline") is not None and opts.validation_lines > 0:  # not when handed to auto
                 result["validation"] = validate(result.model, ModelSpace(problem), sampler, opts.validation_lines,
                                                 opts.validation_points, opts.seed, f_min=result.fun)
@@ -158,6 +138,16 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
         _account(result, sampler)
     result["wall_time_s"] = time.perf_counter() - t0
     return result
+
+
+def _split_options(problem: DesignProblem, method: str | Callable[..., Any],
+                   options: Mapping[str, Any] | SparseOptions | None, budget: int, seed: int,
+                   x0: np.ndarray | None) -> tuple[SparseOptions, dict[str, Any]]:
+    """The run's SparseOptions (budget, seed, and the line model's settings) and the method's own checked options:
+    a line model's options are its SparseOptions, any other method's are checked against its record."""
+    whole = get_method(method).line_model or isinstance(options, SparseOptions)
+    own = {} if whole else check_options(method, options)
+    return checked_options(problem, method, options if whole else None, budget, seed, x0), own
 
 
 def _account(result: OptimizeResult, sampler: Sampler) -> None:
@@ -223,17 +213,19 @@ def _open_store(store: str | Path | SampleStore | None, stack: contextlib.ExitSt
 
 
 def run_method(problem: DesignProblem, method: str | Callable[..., Any], opts: SparseOptions, sampler: Sampler,
-               log: Callable[[str], None], x0: np.ndarray | None = None) -> OptimizeResult:
+               log: Callable[[str], None], x0: np.ndarray | None = None,
+               options: Mapping[str, Any] | None = None) -> OptimizeResult:
     """Run one method on ``problem`` through ``sampler`` (its store and executor), within ``opts.budget``.
 
-    The dispatch of :func:`minimize`, shared with ``mechopt study``; arguments are checked by the caller.
+    The dispatch of :func:`minimize` through the table of methods (:data:`mechopt.optimize.methods.METHODS`), shared
+    with ``mechopt study``; arguments are checked by the caller.
 
     Parameters
     ----------
     problem : DesignProblem
         The problem.
     method : str or callable
-        A name of :func:`mechopt.optimize.arguments.available_methods` or ``f(counted_problem, seed)``.
+        A name of :func:`mechopt.optimize.methods.available_methods` or ``f(counted_problem, seed, **options)``.
     opts : SparseOptions
         The budget, the seed and the sparse method's settings.
     sampler : Sampler
@@ -242,20 +234,24 @@ def run_method(problem: DesignProblem, method: str | Callable[..., Any], opts: S
         Where progress lines go.
     x0 : (m, d) ndarray, optional
         Checked designs simulated first, on top of ``opts.budget`` (:func:`minimize` takes them out of its budget).
+    options : mapping, optional
+        The method's own checked options (:func:`mechopt.optimize.methods.check_options`).
 
     Returns
     -------
     OptimizeResult
         Without ``validation`` (held-out lines are the caller's choice).
     """
+    record = get_method(method)
+    call = MethodCall(problem, opts, sampler, log, record.name, dict(options or {}))
     if x0 is None:
-        return _run(problem, method, opts, sampler, log)
-    if method == AUTO_METHOD:
-        # Its model starts from them (they stand in for as many Sobol designs), which it simulates first: the best
-        # of them is in its answer.
-        return _auto(problem, int(opts.budget), int(opts.seed), sampler, initial=x0)
+        return record.run(call)
+    if record.starts_from_x0:
+        # Its model starts from them (they stand in for as many space-filling designs), which it simulates first:
+        # the best of them is in its answer.
+        return record.run(dataclasses.replace(call, initial=x0))
     values = sampler(x0, desc="x0")
-    return _at_least_x0(_run(problem, method, opts, sampler, log), problem, x0, values)
+    return _at_least_x0(record.run(call), problem, x0, values)
 
 
 def _at_least_x0(result: OptimizeResult, problem: DesignProblem, x0: np.ndarray,
@@ -270,128 +266,3 @@ def _at_least_x0(result: OptimizeResult, problem: DesignProblem, x0: np.ndarray,
     result.update(x=np.array(x0[i], dtype=float), fun=float(values[i]), success=True,
                   message=f"{result.message}; a design of x0 stays the best ({problem.describe(x0[i])})")
     return result
-
-
-def _run(problem: DesignProblem, method: str | Callable[..., Any], opts: SparseOptions, sampler: Sampler,
-         log: Callable[[str], None]) -> OptimizeResult:
-    if method == AUTO_METHOD:
-        return _auto(problem, int(opts.budget), int(opts.seed), sampler)
-    if method == "sparse":
-        return _sparse(problem, opts, sampler, log)
-    if method == "sparse-global":
-        return _sparse_global(problem, int(opts.budget), int(opts.seed), sampler)
-    fn = method if callable(method) else _baselines()[method]
-    return _baseline(problem, fn, int(opts.budget), int(opts.seed), sampler,
-                     method if isinstance(method, str) else getattr(fn, "__name__", "custom"))
-
-
-def _sparse(problem: DesignProblem, opts: SparseOptions, sampler: Sampler, log: Callable[[str], None]):
-    space = ModelSpace(problem)
-    try:
-        pipeline = run_pipeline(space, opts, sampler, log=log)
-    except MechoptError as exc:
-        if isinstance(exc, InputError | BrokenSimulatorError) or not sampler.failures:
-            raise
-        return _handed_to_auto(problem, opts, sampler, f"the line model could not be built ({exc})", log)
-    success = bool(np.isfinite(pipeline.fun) and space.feasible(pipeline.x)[0])
-    return OptimizeResult(x=pipeline.x, fun=pipeline.fun, nfev=len(sampler.designs), success=success,
-                          message=pipeline.message, method="sparse", model=pipeline.stages[0].model,
-                          stages=pipeline.stages, pipeline=pipeline, validation=None, options=opts,
-                          trust=study_trust(pipeline.stages[0], pipeline.best, None))
-
-
-def _sparse_global(problem: DesignProblem, budget: int, seed: int, sampler: Sampler) -> OptimizeResult:
-    from mechopt.optimize.sparse_global import global_search
-
-    def evaluate(X: np.ndarray) -> np.ndarray:
-        return sampler(np.atleast_2d(X), desc="sparse-global")
-
-    def margins(X: np.ndarray) -> np.ndarray:
-        return problem.constraint_margins(np.atleast_2d(X))
-
-    # A least-squares problem keeps a fifth of the budget for Gauss-Newton from the global phase's best design.
-    local = max(5 * (problem.dim + 1), budget // 5) if problem.residuals and budget >= 60 else 0
-    res = global_search(evaluate, problem.bounds, problem.feasible, problem.sampleable, budget=budget - local,
-                        fit=problem.fit, seed=seed, margins=margins if problem.constraints else None,
-                        batch=sampler.batch_size)
-    x, fun = np.asarray(res.x, dtype=float), float(res.fun)
-    trust = dict(res.trust)
-    message = str(trust.get("verdict", ""))
-    if local and np.all(np.isfinite(x)):
-        from mechopt.optimize.least_squares import least_squares_polish
-
-        x_ls, run = least_squares_polish(lambda X: sampler.residuals(X, desc="sparse-global: Gauss-Newton"),
-                                         problem.bounds, x, budget - len(sampler.designs), problem.fd_step,
-                                         batch=sampler.batch_size, feasible=problem.feasible,
-                                         margins=margins if problem.constraints else None)
-        if np.isfinite(run.value) and run.value < fun:
-            x, fun = np.asarray(x_ls, dtype=float), float(run.value)
-        message += f"; Gauss-Newton on the residuals from its best design: {fun:.6g} ({run.message})"
-    success = bool(np.all(np.isfinite(x)) and problem.feasible(x)[0])
-    return OptimizeResult(x=x, fun=fun, nfev=len(sampler.designs), success=success, message=message,
-                          method="sparse-global", model=None, models=res.models, stages=[], validation=None,
-                          trust=trust)
-
-
-def _handed_to_auto(problem: DesignProblem, opts: SparseOptions, sampler: Sampler, why: str,
-                    log: Callable[[str], None]) -> OptimizeResult:
-    """The rest of the budget to the default method, which learns where the simulator fails, with every design the
-    line model simulated as its start (failed simulations must not end a run: issue 22)."""
-    left = int(opts.budget) - len(sampler.designs)
-    log(f"  {why}: the remaining {left} simulations go to method 'auto'")
-    initial = np.array([d for d, _ in sampler.history.values()]) if sampler.history else None
-    result = _auto(problem, max(left, 0), int(opts.seed), sampler, initial=initial)
-    result["message"] = f"{why}; {result.message}"
-    result["method"] = "sparse"
-    return result
-
-
-def _auto(problem: DesignProblem, budget: int, seed: int, sampler: Sampler,
-          initial: np.ndarray | None = None) -> OptimizeResult:
-    from mechopt.optimize.auto import auto_search
-
-    def evaluate(X: np.ndarray) -> np.ndarray:
-        return sampler(np.atleast_2d(X), desc=AUTO_METHOD)
-
-    def residuals(X: np.ndarray) -> tuple[np.ndarray, list]:
-        return sampler.residuals(np.atleast_2d(X), desc=AUTO_METHOD)
-
-    def margins(X: np.ndarray) -> np.ndarray:
-        return problem.constraint_margins(np.atleast_2d(X))
-
-    res = auto_search(evaluate, problem.bounds, budget, seed, feasible=problem.feasible,
-                      batch=sampler.batch_size, margins=margins if problem.constraints else None,
-                      residuals=residuals if problem.residuals else None, fd_step=problem.fd_step, initial=initial)
-    success = bool(np.all(np.isfinite(res.x)) and problem.feasible(res.x)[0])
-    return OptimizeResult(x=res.x, fun=res.fun, nfev=len(sampler.designs), success=success, message=res.message,
-                          method=AUTO_METHOD, plan=res.plan.name, model=None, stages=[], validation=None)
-
-
-def _baseline(problem: DesignProblem, fn: Callable[..., Any], budget: int, seed: int, sampler: Sampler,
-              name: str) -> OptimizeResult:
-    from mechopt.optimize.budget import CountedProblem
-
-    def objective(x: np.ndarray) -> float:
-        value = float(sampler(np.asarray(x, dtype=float)[None, :], desc=name)[0])
-        if not np.isfinite(value):
-            raise InfeasibleDesignError(f"the simulation of {problem.describe(x)} did not succeed")
-        return value
-
-    def margins(X: np.ndarray) -> np.ndarray:
-        X = np.asarray(X, dtype=float)
-        M = problem.constraint_margins(np.atleast_2d(X))
-        return M[0] if X.ndim == 1 else M
-
-    progress, sampler.progress = sampler.progress, False
-    counted = CountedProblem(objective, problem.bounds, budget, margins if problem.constraints else None,
-                             failure_errors=(InfeasibleDesignError,), vectorized_constraints=True)
-    try:
-        res = fn(counted, seed)
-    finally:
-        sampler.progress = progress
-    x = counted.best_x
-    success = x is not None
-    return OptimizeResult(x=np.asarray(x if success else res.x, dtype=float), fun=float(counted.best_f) if success
-                          else float("nan"), nfev=counted.nfev, success=success,
-                          message=str(getattr(res, "message", "")) or ("done" if success else "no feasible design"),
-                          method=name, model=None, stages=[], validation=None)

@@ -3,14 +3,19 @@ type, allowed values or range and a description; checking and help text come fro
 
 from __future__ import annotations
 
+import collections.abc
+import inspect
 import math
-from collections.abc import Iterable, Mapping
+import re
+import types
+import typing
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
 from mechopt.errors import InputError
 
-__all__ = ["Option", "Options"]
+__all__ = ["Option", "Options", "options_of"]
 
 
 @dataclass(frozen=True)
@@ -117,3 +122,64 @@ class Options:
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self._values})"
+
+
+def _option_types(hint: Any) -> tuple[tuple[type, ...], bool]:
+    """The runtime types of a type hint (``int | None``, ``tuple[float, float]``, ``Sequence[float]``) and whether
+    None is accepted."""
+    args = typing.get_args(hint) if isinstance(hint, types.UnionType) or typing.get_origin(hint) is typing.Union \
+        else (hint,)
+    found: list[type] = []
+    for arg in args:
+        origin = typing.get_origin(arg) or arg
+        if origin is collections.abc.Sequence:
+            found.extend((tuple, list))
+        elif isinstance(origin, type) and origin is not type(None):
+            found.append(origin)
+    return tuple(found) or (object,), type(None) in args
+
+
+def _parameter_texts(doc: str) -> dict[str, str]:
+    """Each parameter's description in a (dedented) numpydoc docstring, its first sentence, by name; grouped names
+    (``fd_step, ftol, maxiter``) share theirs."""
+    section = re.split(r"^Parameters\n-+\n", doc, maxsplit=1, flags=re.M)
+    if len(section) < 2:
+        return {}
+    texts: dict[str, str] = {}
+    names: list[str] = []
+    for line in re.split(r"^\w+\n-+\n", section[1], maxsplit=1, flags=re.M)[0].splitlines():
+        head = re.fullmatch(r"([A-Za-z_][\w, ]*?)\s*(?::\s*(.*))?", line)
+        if head:
+            names = [n.strip() for n in head.group(1).split(",")]
+            see = head.group(2) or ""
+            texts.update({name: see if see.startswith("see ") else "" for name in names})
+        elif line.startswith("    ") and names:
+            texts.update({name: f"{texts[name]} {line.strip()}".strip() for name in names})
+    # The first sentence: a full stop before a capital, not one of an abbreviation ("et al.", "Eq.").
+    return {name: re.split(r"(?<! al)(?<! Eq)\.\s+(?=[A-Z])", text)[0].rstrip(".") for name, text in texts.items()}
+
+
+def options_of(fn: Callable[..., Any]) -> tuple[Option, ...]:
+    """The options a function declares by its keyword-only parameters: default, type hint and the description of
+    its docstring's Parameters section.
+
+    Parameters
+    ----------
+    fn : callable
+        ``f(problem, seed, *, name=default, ...)``; a ``**kwargs`` catch-all declares nothing.
+
+    Returns
+    -------
+    tuple of Option
+        In the signature's order.
+    """
+    hints = typing.get_type_hints(fn)
+    texts = _parameter_texts(inspect.getdoc(fn) or "")
+    declared = []
+    for p in inspect.signature(fn).parameters.values():
+        if p.kind is not inspect.Parameter.KEYWORD_ONLY:
+            continue
+        kinds, nullable = _option_types(hints.get(p.name, object))
+        declared.append(Option(p.name, p.default, kinds, texts.get(p.name) or "see the function's docstring",
+                               nullable=nullable or p.default is None))
+    return tuple(declared)

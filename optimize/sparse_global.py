@@ -30,7 +30,6 @@ batch evaluator ``evaluate(X (n, d)) -> (n,)``, so a caller can put a store or a
 from __future__ import annotations
 
 import math
-import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -40,24 +39,22 @@ import numpy as np
 from mechopt.errors import InputError
 from mechopt.optimize.sparse.model_confidence import RESOLVED
 from mechopt.optimize.sparse.model_exploration import DISTANCE_CYCLE, explore
-from mechopt.surrogate import LinePlan, SparseExponentialModel, SurrogateError, exhaustive_search, plan_lines
-from mechopt.surrogate.basins import Minima, field_minima, thin
-from mechopt.surrogate.errors import SurrogateWarning
-from mechopt.surrogate.line_error import LineOutError, blend_spread, leave_one_line_out
+from mechopt.optimize.sparse_global_lines import (
+    MIN_LINES,
+    MIN_RUN,
+    CountedUnitCube,
+    FittedLines,
+    as_objective,
+    blend_basins,
+    line_stage,
+)
+from mechopt.surrogate import SparseExponentialModel
+from mechopt.surrogate.basins import Minima, thin
 
 __all__ = ["GlobalSearchResult", "global_search"]
 
 Predicate = Callable[[np.ndarray], np.ndarray]
 BatchEvaluator = Callable[[np.ndarray], np.ndarray]
-
-#: Grid points per axis of the basin search (d = 2, 3, 4).
-_GRID = {2: 121, 3: 33, 4: 15}
-#: Grid points of the exhaustive search of a blend (paper 002: 10 million for its single model).
-_SEARCH_POINTS = {2: 40_000, 3: 200_000, 4: 400_000}
-#: Fewest lines of a plan, per dimension (the blend needs more nodes than its normal plane has dimensions).
-_MIN_LINES = {2: 3, 3: 4, 4: 5}
-#: Fewest samples a line keeps (a sum of exponentials of order 1 with a constant needs 4).
-_MIN_RUN = 4
 
 
 @dataclass
@@ -106,192 +103,6 @@ class GlobalSearchResult:
     history_x: np.ndarray
     history_f: np.ndarray
     stages: list[dict[str, Any]] = field(default_factory=list)
-
-
-class _Counted:
-    """The batch evaluator behind a hard budget, in unit-cube coordinates, remembering every value and its source."""
-
-    def __init__(self, evaluate: BatchEvaluator, lower: np.ndarray, width: np.ndarray, budget: int):
-        self.evaluate = evaluate
-        self.lower, self.width = lower, width
-        self.budget = budget
-        self.Z: list[np.ndarray] = []
-        self.f: list[float] = []
-        self.source: list[str] = []
-        self._memo: dict[bytes, float] = {}
-
-    @property
-    def nfev(self) -> int:
-        return len(self.f)
-
-    @property
-    def remaining(self) -> int:
-        return self.budget - self.nfev
-
-    def x(self, Z: np.ndarray) -> np.ndarray:
-        return self.lower + np.atleast_2d(Z) * self.width
-
-    def __call__(self, Z: np.ndarray, source: str) -> np.ndarray:
-        """Values at unit-cube designs Z (n, d); repeated designs are free, designs beyond the budget get NaN."""
-        Z = np.atleast_2d(np.asarray(Z, dtype=float))
-        out = np.full(Z.shape[0], np.nan)
-        todo, keys = [], []
-        for j, z in enumerate(Z):
-            key = z.tobytes()
-            if key in self._memo:
-                out[j] = self._memo[key]
-            elif key not in keys and len(todo) < self.remaining:
-                todo.append(j)
-                keys.append(key)
-        if todo:
-            values = np.asarray(self.evaluate(self.x(Z[todo])), dtype=float).reshape(-1)
-            if values.size != len(todo):
-                raise InputError(f"evaluate returned {values.size} values for {len(todo)} designs")
-            for j, key, v in zip(todo, keys, values, strict=True):
-                v = float(v) if math.isfinite(v) else math.nan
-                self._memo[key] = v
-                self.Z.append(Z[j].copy())
-                self.f.append(v)
-                self.source.append(source)
-        for j, z in enumerate(Z):
-            out[j] = self._memo.get(z.tobytes(), np.nan)
-        return out
-
-    def best(self, feasible: Predicate) -> tuple[np.ndarray, float, str]:
-        if not self.f:
-            return np.full(self.lower.size, np.nan), math.nan, ""
-        f = np.array(self.f)
-        ok = np.isfinite(f) & feasible(np.array(self.Z))
-        if not ok.any():
-            return np.full(self.lower.size, np.nan), math.nan, ""
-        j = int(np.flatnonzero(ok)[np.argmin(f[ok])])
-        return self.Z[j], float(f[j]), self.source[j]
-
-
-@dataclass
-class _Fitted:
-    """A line model fitted to its samples (unit-cube coordinates)."""
-
-    model: SparseExponentialModel
-    values: list[np.ndarray]
-    lolo: LineOutError | None
-
-
-def _trim(plan: LinePlan, max_samples: int) -> LinePlan:
-    """Shorten the lines about their middles, in proportion, until the plan asks for at most ``max_samples``."""
-    kr = np.asarray(plan.k_ranges)
-    counts = kr[:, 1] - kr[:, 0] + 1
-    if counts.sum() <= max_samples:
-        return plan
-    keep = np.maximum(_MIN_RUN, np.floor(counts * max_samples / counts.sum()).astype(int))
-    while keep.sum() > max_samples and keep.max() > _MIN_RUN:
-        keep[np.argmax(keep)] -= 1
-    start = kr[:, 0] + (counts - keep) // 2
-    return plan.with_k_ranges(np.column_stack([start, start + keep - 1]))
-
-
-def _longest_finite_run(values: np.ndarray) -> slice:
-    ok = np.concatenate(([False], np.isfinite(values), [False])).astype(np.int8)
-    edges = np.flatnonzero(np.diff(ok))
-    if edges.size == 0:
-        return slice(0, 0)
-    starts, stops = edges[0::2], edges[1::2]
-    j = int(np.argmax(stops - starts))
-    return slice(int(starts[j]), int(stops[j]))
-
-
-def _box_predicate(lo: np.ndarray, hi: np.ndarray, inner: Predicate) -> Predicate:
-    def pred(Z: np.ndarray) -> np.ndarray:
-        Z = np.atleast_2d(Z)
-        ok = np.all((Z >= lo - 1e-12) & (Z <= hi + 1e-12), axis=1)
-        if ok.any():
-            ok[ok] = np.asarray(inner(Z[ok]), dtype=bool).reshape(-1)
-        return ok
-    return pred
-
-
-def _line_stage(counted: _Counted, lo: np.ndarray, hi: np.ndarray, feasible: Predicate, sampleable: Predicate,
-                n_lines: int, samples_per_line: int, max_samples: int, fit: str, max_order: int, seed: int,
-                source: str) -> _Fitted | None:
-    """Plan lines over [lo, hi] ∩ feasible, sample them (capped), fit and blend; None if no plan or fit exists."""
-    min_samples = min(samples_per_line, max(_MIN_RUN, samples_per_line // 2))
-    res = None
-    for attempt in range(3):  # a plan may fail for an odd seed or a thin region: two more seeds, nothing spent yet
-        try:
-            res = plan_lines(lo, hi, feasible, n_lines=n_lines, samples_per_line=samples_per_line,
-                             min_samples=min_samples, n_probe=4000, n_random=4, n_refine=8, seed=seed + 1000 * attempt,
-                             sampleable=sampleable, layout="fekete")
-            break
-        except SurrogateError:
-            continue
-    if res is None:
-        return None
-    plan = _trim(res.plan, max_samples)
-    designs = [plan.points(i, np.arange(k0, k1 + 1)) for i, (k0, k1) in enumerate(plan.k_ranges)]
-    values = counted(np.vstack(designs), source)
-    samples, kept, k_ranges, start = [], [], [], 0
-    for i, D in enumerate(designs):
-        v = values[start : start + len(D)]
-        start += len(D)
-        run = _longest_finite_run(v)  # a failed evaluation splits a line: fit its longest clean stretch
-        ks = np.arange(plan.k_ranges[i][0], plan.k_ranges[i][1] + 1)[run]
-        v = v[run]
-        if v.size < 4:
-            return None
-        if fit == "square" and np.any(v < 0):
-            raise InputError(f"fit='square' needs a non-negative objective, got {v.min():.4g} on a line")
-        samples.append((ks, v * v if fit == "square" else v))
-        kept.append(v * v if fit == "square" else v)
-        k_ranges.append([int(ks[0]), int(ks[-1])])
-    plan = plan.with_k_ranges(np.array(k_ranges))
-    order_cap = max(1, min(max_order, (min(len(v) for v in kept) - 1) // 2))
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", SurrogateWarning)
-            model = SparseExponentialModel(max_order=order_cap).fit(plan, samples)
-    except SurrogateError:
-        return None
-    try:
-        lolo = leave_one_line_out(model, kept) if model.l >= 3 else None
-    except SurrogateError:
-        lolo = None
-    return _Fitted(model, kept, lolo)
-
-
-def _basins(fitted: _Fitted, lo: np.ndarray, hi: np.ndarray, feasible: Predicate, kappa: float, n_model: int,
-            n_bound: int, radius: float) -> tuple[Minima, Minima]:
-    """Distinct minima of the blend and of ``blend − κ·spread`` over the grid of [lo, hi] ∩ hull ∩ feasible."""
-    model = fitted.model
-    hull = model.hull
-
-    def region(Z: np.ndarray) -> np.ndarray:
-        ok = hull.contains(Z)
-        if ok.any():
-            ok[ok] = np.asarray(feasible(Z[ok]), dtype=bool).reshape(-1)
-        return ok
-
-    n = _GRID[lo.size]
-    by_model = field_minima(lambda Z: model.predict(Z), lo, hi, region, n, radius, n_model)
-    # The paper's own answer, the exhaustive search of the blend (finer grid, polished), leads the model's minima.
-    found = exhaustive_search(model, feasible=lambda Z: feasible(Z) & _box_predicate(lo, hi, feasible)(Z),
-                              n_points=_SEARCH_POINTS[lo.size])
-    if found.success:
-        by_model = thin(np.vstack([found.x[None, :], by_model.x]), np.concatenate([[found.fun], by_model.value]),
-                        radius, n_model)
-    if kappa > 0 and n_bound > 0 and model.l >= 4:
-        try:
-            by_bound = field_minima(lambda Z: model.predict(Z) - kappa * blend_spread(model, Z), lo, hi, region, n,
-                                    radius, n_bound)
-        except SurrogateError:
-            by_bound = Minima(np.zeros((0, lo.size)), np.zeros(0))
-    else:
-        by_bound = Minima(np.zeros((0, lo.size)), np.zeros(0))
-    return by_model, by_bound
-
-
-def _as_objective(fit: str, value: np.ndarray) -> np.ndarray:
-    value = np.asarray(value, dtype=float)
-    return np.sqrt(np.maximum(value, 0.0)) if fit == "square" else value
 
 
 def global_search(evaluate: BatchEvaluator, bounds: Any, feasible: Predicate, sampleable: Predicate | None = None,
@@ -412,7 +223,7 @@ class _GlobalRun:
         self.dim = bounds.shape[0]
         self.budget, self.fit = budget, fit
         self.feas_z, self.samp_z = self._in_unit_cube(feasible), self._in_unit_cube(sampleable)
-        self.counted = _Counted(evaluate, self.lower, self.width, int(budget))
+        self.counted = CountedUnitCube(evaluate, self.lower, self.width, int(budget))
         self.models: dict[str, SparseExponentialModel] = {}
         self.cand_z: list[np.ndarray] = []
         self.cand_f: list[float] = []
@@ -425,15 +236,15 @@ class _GlobalRun:
         return lambda Z: np.asarray(pred(lower + np.atleast_2d(Z) * width), dtype=bool).reshape(-1)
 
     def global_stage(self, global_share: float, samples_per_line: int, n_lines: int | None, max_order: int, seed: int,
-                     kappa: float, n_candidates: int, basin_radius: float) -> _Fitted | None:
+                     kappa: float, n_candidates: int, basin_radius: float) -> FittedLines | None:
         """Steps 1 and 2: the global lines sampled and blended, then every distinct minimum of the blend and of its
         optimistic bound simulated.  None when no line plan or fit exists."""
         counted, dim = self.counted, self.dim
         n_global = int(round(global_share * self.budget))
-        l_global = n_lines or max(_MIN_LINES[dim], n_global // samples_per_line)
-        n_global = max(n_global, _MIN_RUN * l_global)
+        l_global = n_lines or max(MIN_LINES[dim], n_global // samples_per_line)
+        n_global = max(n_global, MIN_RUN * l_global)
         zero, one = np.zeros(dim), np.ones(dim)
-        glob = _line_stage(counted, zero, one, self.feas_z, self.samp_z, l_global, samples_per_line, n_global,
+        glob = line_stage(counted, zero, one, self.feas_z, self.samp_z, l_global, samples_per_line, n_global,
                            self.fit, max_order, seed, "global lines")
         if glob is None:
             self.stages.append({"name": "global", "lines": 0, "nfev": counted.nfev, "message": "no line plan fits"})
@@ -441,7 +252,7 @@ class _GlobalRun:
         self.models["global"] = glob.model
         if glob.lolo is not None:
             self.trust["lolo_median"], self.trust["lolo_max"] = glob.lolo.median, glob.lolo.max
-        by_model, by_bound = _basins(glob, zero, one, self.feas_z, kappa, n_candidates, n_candidates, basin_radius)
+        by_model, by_bound = blend_basins(glob, zero, one, self.feas_z, kappa, n_candidates, n_candidates, basin_radius)
         first = len(self.cand_z)
         self.simulate_candidates([by_model, by_bound], glob.model, "global model")
         self.stages.append({"name": "global", "lines": glob.model.l, "nfev": counted.nfev,
@@ -464,7 +275,7 @@ class _GlobalRun:
         for z, fz, p in zip(pts.x, f, pts.value, strict=True):
             self.cand_z.append(z)
             self.cand_f.append(float(fz))
-            self.cand_pred.append(float(_as_objective(self.fit, p)))
+            self.cand_pred.append(float(as_objective(self.fit, p)))
 
     def _record_claim(self, by_model: Minima, first: int) -> None:
         """How far the model's own claim (its best minimum, simulated first among the candidates from ``first``)
@@ -476,7 +287,7 @@ class _GlobalRun:
         if j is not None and sampled_range > 0 and math.isfinite(self.cand_f[j]):
             self.trust["claim_error"] = abs(self.cand_pred[j] - self.cand_f[j]) / sampled_range
 
-    def corrected_steps(self, glob: _Fitted | None, exploit_share: float, seed: int, cycle: tuple[float, ...],
+    def corrected_steps(self, glob: FittedLines | None, exploit_share: float, seed: int, cycle: tuple[float, ...],
                         margins: Callable[[np.ndarray], np.ndarray] | None, batch: int = 1) -> None:
         """Step 3: steps on the blend corrected by every simulation, first cycling through distances from the
         simulated designs (unseen regions, then closer), then at the corrected model's own minimum."""

@@ -133,7 +133,7 @@ def result_dict(run) -> dict[str, Any]:
 
 
 def write_outputs(run) -> None:
-    """Write the figures, result.json and report.md of a :class:`~mechopt.cli.run_study.StudyRun`."""
+    """Write the figures, result.json and report.md of a :class:`~mechopt.studies.runner.StudyRun`."""
     result = result_dict(run)
     result["figures"] = _figures(run)
     try:

@@ -33,7 +33,21 @@ from scipy.optimize import OptimizeResult, minimize
 from mechopt.optimize.baselines.library import require, worst_feasible_value
 from mechopt.optimize.budget import BudgetExhausted, CountedProblem
 
-__all__ = ["minimize_smt_ego"]
+__all__ = ["EGO_MAX_BUDGETS", "max_budget", "minimize_smt_ego"]
+
+#: The largest budget ``mechopt compare`` runs EGO at, as (most variables, budget): each step refits Kriging (a
+#: hyperparameter search per variable) on every sample, a cost that grows with the cube of the simulations and with
+#: the dimension; these are the budgets where a step still takes about 3 s of CPU on one BLAS thread
+#: (benchmarks/bench_peer_budgets.py measures them; beyond 8 variables a step at 30 samples is not measured).
+EGO_MAX_BUDGETS = ((3, 100), (5, 60), (12, 30))
+
+
+def max_budget(dim: int) -> int:
+    """The largest budget ``mechopt compare`` runs EGO at on ``dim`` variables (:data:`EGO_MAX_BUDGETS`)."""
+    for most, budget in EGO_MAX_BUDGETS:
+        if dim <= most:
+            return budget
+    return EGO_MAX_BUDGETS[-1][1]
 
 
 def _constrained_ego(ego_class: type, problem: CountedProblem, rng: np.random.Generator, n_candidates: int) -> type:

@@ -30,12 +30,18 @@ def test_studies_lists_every_study_and_test_function_with_a_description(capsys):
     assert "test function, 3 variables: Hartmann-3" in listed["hartmann3"]
 
 
-def test_methods_lists_every_method(capsys):
+def test_methods_lists_every_method_with_its_options(capsys):
     assert main(["methods"]) == 0
     out = capsys.readouterr().out
-    names = [line.split()[0] for line in out.splitlines() if line.strip() and not line.startswith("choose")]
-    assert names == available_methods()
-    assert all(len(line.split(None, 1)) == 2 for line in out.splitlines()[: len(names)])  # each has a description
+    heads = [line for line in out.splitlines() if line.strip() and not line.startswith((" ", "choose"))]
+    assert [line.split()[0] for line in heads] == available_methods()
+    assert all(len(line.split(None, 1)) == 2 for line in heads)  # each has a description
+    assert "    n_starts (int, default 5): Planned starts" in out  # slsqp's option, with its default
+    assert main(["methods", "cobyqa"]) == 0
+    one = capsys.readouterr().out
+    assert one.startswith("cobyqa  ") and "initial_tr_radius (float, default 0.25)" in one
+    assert main(["methods", "magic"]) == 1
+    assert "method = 'magic'; expected one of auto" in capsys.readouterr().err
 
 
 def test_study_runs_a_chosen_method(tmp_path, capsys):

@@ -92,14 +92,12 @@ def quiet_peer(problem, seed: int):
 
 @pytest.fixture
 def test_only_peers(monkeypatch):
-    from mechopt.cli import compare as cmp
-    from mechopt.optimize.baselines import BASELINES
+    from mechopt.optimize.methods import METHODS, Method
 
-    # Registered where `mechopt compare` and `mechopt.minimize` resolve method names; quiet_peer counts as a
-    # library peer, one that must spend its whole budget.
-    monkeypatch.setitem(BASELINES, "flaky_peer", flaky_peer)
-    monkeypatch.setitem(BASELINES, "quiet_peer", quiet_peer)
-    monkeypatch.setattr(cmp, "SPENDS_WHOLE_BUDGET", cmp.SPENDS_WHOLE_BUDGET | {"quiet_peer"})
+    # Two records in the table of methods, which `mechopt compare` and `mechopt.minimize` read; quiet_peer counts as
+    # a library peer, one that must spend its whole budget.
+    monkeypatch.setitem(METHODS, "flaky_peer", Method("flaky_peer", flaky_peer, "test only"))
+    monkeypatch.setitem(METHODS, "quiet_peer", Method("quiet_peer", quiet_peer, "test only", spends_whole_budget=True))
 
 
 def test_a_peer_failing_part_way_is_marked_and_not_counted(tmp_path, capsys, test_only_peers):
@@ -136,14 +134,37 @@ def test_a_peer_failing_part_way_is_marked_and_not_counted(tmp_path, capsys, tes
 
     md = (tmp_path / "compare.md").read_text()
     assert "| flaky_peer | 20 | 2 |" in md and "| 1 † |" in md and "| 2 † |" in md
-    assert "| quiet_peer | 20 | 2 | — | — | — | — | — |" in md  # nothing finished: nothing scored
+    assert "| quiet_peer | 20 | 2 | — | — | — | 0.397887 | — | — |" in md  # nothing finished: only f* to show
     assert "3 run(s) stopped before spending their budget and are not counted" in md
     assert "- flaky_peer at budget 20, seed 0: 4 of 20 simulations, stopped before its budget (raised" in md
-    assert "| flaky_peer | " in md.split("Median gap")[1] and "% † |" in md.split("Median gap")[1]
+    assert "| flaky_peer | " in md.split("Median gap")[1] and ") † |" in md.split("Median gap")[1]
+
+
+def test_every_compare_table_states_its_measure_and_shows_f_and_f_star(tmp_path):
+    # DE on Branin at 20 simulations: a gap of a fraction of a per cent of the range (308) can be f three times f*;
+    # the tables say what the gap is a percentage of and show f and f* beside it.
+    from mechopt.studies import comparison as cmp
+    from mechopt.studies.catalogue import load_study
+
+    study = load_study("branin", {})
+    truth = cmp.known_truth(study.problem)
+    runs = cmp.compare(study, truth, [20], 1, ["differential_evolution"], progress=lambda _line: None)
+    md_path, _ = cmp.write(runs, truth, tmp_path, study, 1)
+    md = md_path.read_text()
+    value = runs[0].value
+    assert value > truth.fun
+    assert runs[0].gap_pct == pytest.approx(100 * (value - truth.fun) / study.problem.f_range)
+    assert "Gap: % of the range of f over the box (307.7): 100 (f - f*) / range." in md
+    header = next(line for line in md.splitlines() if line.startswith("| method | budget"))
+    assert "| median f | best f | worst f | f* | median gap (% of the range of f) |" in header
+    row = next(line for line in md.splitlines() if line.startswith("| differential_evolution | 20 |"))
+    assert f"| {value:.6g} | {value:.6g} | {value:.6g} | {truth.fun:.6g} | {runs[0].gap_pct:+.2f} % |" in row
+    pivot = md.split("Median gap to the optimum f* = 0.397887 (% of the range of f over the box")[1]
+    assert f"| differential_evolution | {runs[0].gap_pct:+.2f} % (f {value:.4g}) |" in pivot
 
 
 def test_the_headline_marks_methods_with_unfinished_runs():
-    from mechopt.cli.compare import headline, unfinished_methods
+    from mechopt.studies.comparison import headline, unfinished_methods
 
     rows = [{"method": "peer", "budget": 30, "median_reached": True, "complete": False},
             {"method": "ours", "budget": 30, "median_reached": True, "complete": True}]
@@ -154,7 +175,8 @@ def test_the_headline_marks_methods_with_unfinished_runs():
 
 
 def test_smt_ego_beyond_its_limit_is_refused_in_one_line(tmp_path, capsys):
-    from mechopt.cli.compare import check_methods, ego_max_budget
+    from mechopt.optimize.baselines.smt_ego import max_budget as ego_max_budget
+    from mechopt.studies.comparison import check_methods
 
     limit = ego_max_budget(2)  # Branin's 2 variables
     code = main(["compare", "--study", "branin", "--out", str(tmp_path), "--seeds", "1", "--budgets",
@@ -172,7 +194,7 @@ def test_smt_ego_beyond_its_limit_is_refused_in_one_line(tmp_path, capsys):
 
 
 def test_a_line_model_named_for_a_study_it_cannot_take_is_refused():
-    from mechopt.cli.compare import check_methods
+    from mechopt.studies.comparison import check_methods
 
     with pytest.raises(InputError, match="--methods mechopt-global: method 'sparse-global' handles 2 to 4"):
         check_methods(["mechopt-global"], [60], dims=[6])
@@ -182,8 +204,8 @@ def test_a_line_model_named_for_a_study_it_cannot_take_is_refused():
 def test_a_run_refused_for_its_budget_is_marked_with_the_reason():
     # Hartmann-4's line plan needs 11 simulations: at 10 the run is refused, and the table says so (it showed an
     # unexplained infinite gap); at 11 it runs.
-    from mechopt.cli.compare import known_truth, run_one
     from mechopt.studies.catalogue import load_study
+    from mechopt.studies.comparison import known_truth, run_one
 
     problem = load_study("hartmann4").problem
     truth = known_truth(problem)
@@ -196,7 +218,7 @@ def test_a_run_refused_for_its_budget_is_marked_with_the_reason():
 
 def test_methods_by_the_names_study_and_minimize_give_them():
     # `mechopt study --method auto` and then `mechopt compare --methods auto` was "unknown method 'auto'".
-    from mechopt.cli.compare import check_methods, method_names
+    from mechopt.studies.comparison import check_methods, method_names
 
     assert method_names("auto,sparse,sparse-global,smt_ego") == ["mechopt-auto", "mechopt-sparse", "mechopt-global",
                                                                  "smt_ego"]

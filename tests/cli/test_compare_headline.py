@@ -1,6 +1,6 @@
 """The headline's count: the budget from which on a method's median run stays at the optimum."""
 
-from mechopt.cli.compare import headline, largest_budgets, simulations_needed
+from mechopt.studies.comparison import headline, largest_budgets, simulations_needed
 
 
 def test_simulations_needed_counts_from_where_the_median_stays_reached():
@@ -28,7 +28,7 @@ def test_merge_replaces_one_methods_runs_and_recounts(tmp_path, monkeypatch):
     import sys
 
     from benchmarks import compare_merge
-    from mechopt.cli import compare as cmp
+    from mechopt.studies import comparison as cmp
     from mechopt.studies.catalogue import load_study
 
     study = load_study("branin", {})

@@ -155,10 +155,10 @@ def test_bad_study_keys(tmp_path, capsys, section, expected):
 
 
 def test_paper_plan_is_expressible():
-    from mechopt.cli.run_study import study_options
     from mechopt.optimize.sparse.space import ModelSpace
     from mechopt.optimize.sparse.stage import paper_plan
     from mechopt.studies.catalogue import load_study
+    from mechopt.studies.runner import study_options
 
     study = load_study("ventilator")
     opts = study_options(study, {"plan": "paper", "samples_per_line": 30, "min_samples": 10})

@@ -6,10 +6,10 @@ from __future__ import annotations
 import pytest
 
 import mechopt
-from mechopt.cli.study_options import study_options
 from mechopt.optimize.sparse.options import LINE_SHARE, SparseOptions
 from mechopt.studies.benchmark_functions import SUITE
 from mechopt.studies.catalogue import load_study
+from mechopt.studies.run_options import study_options
 
 
 @pytest.mark.parametrize("budget", [3, 10, 60, 150, 300, 599, 600, 2000])

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from mechopt.errors import InfeasibleDesignError, StudyError
-from mechopt.optimize.baselines import BASELINES, CountedProblem
+from mechopt.optimize.baselines import CountedProblem, minimize_paper000_hybrid
 from mechopt.studies.catalogue import available_studies, load_study
 from mechopt.studies.kinds.path_synthesis import problem_from_study
 from mechopt.studies.study_file import PACKAGED_STUDIES, StudyFile
@@ -74,7 +74,7 @@ def test_paper000_hybrid_runs_within_a_small_budget_on_example_1():
     counted = CountedProblem(lambda x: problem.evaluate(x)["E"], problem.bounds, 300,
                              lambda X: problem.margins(np.atleast_2d(X)), vectorized_constraints=True,
                              failure_errors=(InfeasibleDesignError,))
-    res = BASELINES["paper000_hybrid"](counted, 0)
+    res = minimize_paper000_hybrid(counted, 0)
     assert res.success and res.nfev == counted.nfev <= 300
     assert problem.feasible(res.x[None])[0]
     assert res.fun == pytest.approx(problem.evaluate(res.x)["E"])

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from mechopt.optimize.methods import get_method
 from mechopt.optimize.sparse.model import ObjectiveModel
 from mechopt.optimize.sparse.options import SparseOptions
 from mechopt.optimize.sparse.space import ModelSpace
@@ -24,11 +25,9 @@ from mechopt.runs.store import SampleStore, design_key
 from mechopt.studies.catalogue import Study
 from mechopt.studies.method_time import method_seconds, method_time_line
 
-__all__ = ["BATCH_METHODS", "PlanStage", "RunPlan", "duration_text", "open_store_if_any", "plan_run",
+__all__ = ["PlanStage", "RunPlan", "duration_text", "open_store_if_any", "plan_run",
            "plan_validation", "seconds_per_run"]
 
-#: The methods that propose as many designs at once as there are workers (issue 28).
-BATCH_METHODS = ("sparse", "sparse-global", "auto")
 
 
 @dataclass(frozen=True)
@@ -214,7 +213,7 @@ def plan_run(study: Study, options: SparseOptions, method: str, store: SampleSto
     options : SparseOptions
         The budget, the line plan and the validation.
     method : str
-        The optimizer (only ``"sparse"`` has lines to count and held-out lines to validate).
+        The optimizer (only a line model has lines to count and held-out lines to validate).
     store : SampleStore, optional
         The store the run will use (None: a new one).
     workers : int
@@ -226,7 +225,8 @@ def plan_run(study: Study, options: SparseOptions, method: str, store: SampleSto
     fingerprint = problem.fingerprint()
     budget = int(options.budget)
     stages: list[PlanStage] = []
-    if method == "sparse":
+    record = get_method(method)
+    if record.line_model:
         stages.append(_line_stage(study, options, store, retry_failed))
         n_lines = stages[-1].simulations
         stages.append(PlanStage("confirm the model's candidate", 1))
@@ -234,8 +234,8 @@ def plan_run(study: Study, options: SparseOptions, method: str, store: SampleSto
             stages.extend(_refinement(budget - n_lines - 1, workers, problem.dim))
         n_val_lines, per_line = options.validation_plan()
     else:
-        # sparse-global and auto propose batches of ``workers`` designs (issue 28); the baselines one at a time.
-        stages.append(PlanStage(f"method {method}", budget, parallel=method in BATCH_METHODS, exact=False))
+        # mechopt's other methods propose batches of ``workers`` designs; the baselines one at a time.
+        stages.append(PlanStage(f"method {method}", budget, parallel=record.batches, exact=False))
         n_val_lines, per_line = 0, 0
     validation = n_val_lines * per_line
     if validation:

@@ -18,9 +18,6 @@ from typing import Any
 
 import numpy as np
 
-from mechopt.cli.study_header import study_header
-from mechopt.cli.study_options import study_options
-from mechopt.cli.study_plan import RunPlan, duration_text, open_store_if_any, plan_run, plan_validation
 from mechopt.errors import InputError, MechoptError
 from mechopt.optimize.arguments import check_method
 from mechopt.optimize.ground_truth import GroundTruth, load_or_compute
@@ -39,7 +36,10 @@ from mechopt.runs.store_path import check_store_folder
 from mechopt.studies import method_cache
 from mechopt.studies.catalogue import Study
 from mechopt.studies.output_folder import check_output_owner
+from mechopt.studies.plan import RunPlan, duration_text, open_store_if_any, plan_run, plan_validation
 from mechopt.studies.reference_check import reference_warning
+from mechopt.studies.run_header import study_header
+from mechopt.studies.run_options import study_options
 
 __all__ = ["StudyRun", "check_output_folder", "check_run", "plan_study", "rounds_text", "run_study",
            "study_options", "summary_lines"]
