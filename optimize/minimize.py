@@ -89,8 +89,7 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
         ``workers`` is then how many designs run at once there: ``workers=None`` for every worker thread of the
         cluster (the default 1 runs one at a time).
     progress : bool
-        Progress bars with rate and ETA; when standard error is not a terminal (a log file, a pipe), one line at
-        each tenth of the budget and at least every 30 s instead.
+        Progress bars; log lines (each tenth of the budget, at least every 30 s) when stderr is not a terminal.
     retry_failed : bool
         Simulate again designs whose earlier simulation failed.
     log : callable, optional
@@ -100,9 +99,7 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
         the budget, the result is never worse than the best of them, and ``"auto"`` fits its model to them in place
         of as many of its space-filling designs.  Inside the bounds and satisfying the declared constraints.
     stop_after_failures : int, optional
-        Stop the run, with the first failure's reason, when its first this-many simulations all failed (default 5;
-        with several workers the designs already running finish too); 0 or None never stops early.  Failures later
-        in a run do not stop it: the methods learn where the simulator fails and avoid it.
+        Stop when the first this-many simulations all failed (default 5; 0 or None: never); later failures do not.
 
     Returns
     -------

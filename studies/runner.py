@@ -146,19 +146,9 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
         for line in [*study_header(study), f"  store {store_path}, {sampler.executor_description}", *plan.text()]:
             log(line)
         watching.enter_context(watch_run(sampler, plan.total, progress=progress,
-                                         stop_after_failures=stop_after_failures,
-                                         retry_hint=f"--retry-failed (retry_failed=True) simulates them again "
-                                         f"(they are recorded in {store_path})"))
+                                         stop_after_failures=stop_after_failures, retry_hint=_retry_hint(store_path)))
         t0 = time.perf_counter()
-        share = options if x0 is None else checked_options(problem, method, options, options.budget, options.seed, x0)
-        key = method_cache.run_key(problem, method, share, x0, sampler.batch_size)
-        result = method_cache.replay(out, key, sampler)
-        if result is None:
-            result = run_method(problem, method, share, sampler, log, x0=x0)
-            method_cache.save(out, key, sampler, result)
-        else:
-            log(f"  {method}: every one of its {len(sampler.designs)} simulations is in the store, unchanged: its "
-                f"answer is replayed from {out / method_cache.CACHE_FILE}")
+        result = _optimise(problem, method, options, sampler, log, x0, out)
         timings["optimise_s"] = time.perf_counter() - t0
         n_opt = len(sampler.designs)
         timing = sampler.timing()
@@ -189,6 +179,25 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
     write_outputs(run)
     timings["report_s"] = time.perf_counter() - t0
     return run
+
+
+def _retry_hint(store_path: Path) -> str:
+    return f"--retry-failed (retry_failed=True) simulates them again (they are recorded in {store_path})"
+
+
+def _optimise(problem, method: str, options: SparseOptions, sampler: Sampler, log: Callable[[str], None],
+              x0: np.ndarray | None, out: Path) -> OptimizeResult:
+    """The method's answer: replayed when every design it asked for is stored unchanged, else computed and kept."""
+    share = options if x0 is None else checked_options(problem, method, options, options.budget, options.seed, x0)
+    key = method_cache.run_key(problem, method, share, x0, sampler.batch_size)
+    result = method_cache.replay(out, key, sampler)
+    if result is None:
+        result = run_method(problem, method, share, sampler, log, x0=x0)
+        method_cache.save(out, key, sampler, result)
+    else:
+        log(f"  {method}: every one of its {len(sampler.designs)} simulations is in the store, unchanged: its "
+            f"answer is replayed from {out / method_cache.CACHE_FILE}")
+    return result
 
 
 def plan_study(study: Study, options: SparseOptions, workers: int | None = None, scheduler: str | None = None,
