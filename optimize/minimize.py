@@ -114,7 +114,7 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
     InputError
         A bad argument, before any simulation.
     BrokenSimulatorError
-        The first ``stop_after_failures`` simulations all failed.
+        The first ``stop_after_failures`` simulations all failed (``mechopt.errors``).
     """
     _check_arguments(problem, budget, method, seed, workers, store)
     stop_after_failures = check_stop_after_failures(stop_after_failures)
@@ -127,13 +127,20 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
         executor = stack.enter_context(make_executor(workers=workers, scheduler=scheduler))
         sampler = Sampler(problem, db, executor, progress, retry_failed)
         with watch_run(sampler, int(budget), progress=progress, stop_after_failures=stop_after_failures):
-            result = run_method(problem, method, opts, sampler, log, x0=X0, options=own)
-            if result.get("pipeline") is not None and opts.validation_lines > 0:  # not when handed to auto
-                result["validation"] = validate(result.model, ModelSpace(problem), sampler, opts.validation_lines,
-                                                opts.validation_points, opts.seed, f_min=result.fun)
-                result["trust"] = study_trust(result.stages[0], result.pipeline.best, result.validation)
+            result = _validated(run_method(problem, method, opts, sampler, log, x0=X0, options=own), problem, opts,
+                                sampler)
         _account(result, sampler)
     result["wall_time_s"] = time.perf_counter() - t0
+    return result
+
+
+def _validated(result: OptimizeResult, problem: DesignProblem, opts: SparseOptions,
+               sampler: Sampler) -> OptimizeResult:
+    """``result`` with the held-out validation of its line model when asked for (not when handed to auto)."""
+    if result.get("pipeline") is not None and opts.validation_lines > 0:
+        result["validation"] = validate(result.model, ModelSpace(problem), sampler, opts.validation_lines,
+                                        opts.validation_points, opts.seed, f_min=result.fun)
+        result["trust"] = study_trust(result.stages[0], result.pipeline.best, result.validation)
     return result
 
 
