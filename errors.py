@@ -21,3 +21,7 @@ class InfeasibleDesignError(MechoptError):
 
 class StudyError(MechoptError):
     """A study definition (TOML) is missing, malformed or incomplete."""
+
+
+class BrokenSimulatorError(MechoptError):
+    """The first simulations of a run all failed: the simulator itself, not the designs, is at fault."""

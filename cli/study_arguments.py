@@ -62,6 +62,8 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--points-per-line", type=positive_int, help="points per held-out line")
     p.add_argument("--retry-failed", action="store_true", help="simulate again designs whose simulation failed")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
+    p.add_argument("--stop-after-failures", type=count, default=5, metavar="K",
+                   help="stop when the run's first K simulations all fail (default 5; 0: never)")
 
 
 def add_method_option(p: argparse.ArgumentParser) -> None:

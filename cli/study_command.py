@@ -28,6 +28,8 @@ def add_parser(sub, engines: tuple[str, ...]) -> None:
                    help="a design to start from, its variables' values comma-separated in the order and units of "
                    "`mechopt study STUDY --dry-run`; repeat for several; simulated first and counted in the budget: "
                    "the answer is never worse")
+    p.add_argument("--force", action="store_true", help="use --out even if it holds another study's or problem's "
+                   "results (their report, result.json, model and figures are removed first; the store is kept)")
     p.add_argument("--truth", action="store_true", help="also brute-force the ground truth (cached)")
     p.add_argument("--truth-grid", type=positive_float, default=1.0, help="its grid step (the variables' unit)")
     add_trade_off_options(p)
@@ -73,7 +75,8 @@ def run(args: argparse.Namespace, rest: list[str]) -> int:
     # run_study checks the run (store, scheduler, feasible region) before it makes the output folder.
     run = run_study(study, out_arg, options, workers=args.workers, scheduler=args.scheduler, store_path=args.store,
                     progress=not args.no_progress, truth=args.truth, truth_step=args.truth_grid,
-                    retry_failed=args.retry_failed, method=args.method, x0=x0)
+                    retry_failed=args.retry_failed, method=args.method, x0=x0,
+                    stop_after_failures=args.stop_after_failures, force=args.force)
     print("\n".join(summary_lines(run)))
     print(f"report: {run.out / 'report.md'}")
     return 0

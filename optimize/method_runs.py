@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from mechopt.errors import InfeasibleDesignError, InputError, MechoptError
+from mechopt.errors import BrokenSimulatorError, InfeasibleDesignError, InputError, MechoptError
 from mechopt.optimize.problem import DesignProblem
 from mechopt.optimize.result import OptimizeResult
 from mechopt.optimize.sparse.model_confidence import study_trust
@@ -81,7 +81,7 @@ def run_sparse(call: MethodCall) -> OptimizeResult:
     try:
         pipeline = run_pipeline(space, opts, sampler, log=call.log)
     except MechoptError as exc:
-        if isinstance(exc, InputError) or not sampler.failures:
+        if isinstance(exc, InputError | BrokenSimulatorError) or not sampler.failures:
             raise
         return _handed_to_auto(call, f"the line model could not be built ({exc})")
     success = bool(np.isfinite(pipeline.fun) and space.feasible(pipeline.x)[0])

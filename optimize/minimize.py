@@ -27,8 +27,11 @@ from mechopt.optimize.sparse.sampler import Sampler
 from mechopt.optimize.sparse.space import ModelSpace
 from mechopt.optimize.sparse.validate import validate
 from mechopt.optimize.trade_off import check_trade_off_method, run_trade_off
+from mechopt.runs.early_stop import DEFAULT_STOP_AFTER_FAILURES, check_stop_after_failures
 from mechopt.runs.executors import make_executor
+from mechopt.runs.run_watch import watch_run
 from mechopt.runs.store import SampleStore
+from mechopt.runs.store_path import check_store_folder
 
 __all__ = ["checked_options", "minimize", "parallel_accounting", "run_method"]
 
@@ -44,6 +47,8 @@ def _check_arguments(problem: Any, budget: Any, method: Any, seed: Any, workers:
     if store is not None and not isinstance(store, str | os.PathLike | SampleStore):
         raise InputError(f"store = {store!r}: expected the path of an SQLite file or a SampleStore")
     check_trade_off_method(problem, method)
+    if isinstance(store, str | os.PathLike):
+        check_store_folder(store, "store =")
     problem.check_region()
 
 
@@ -51,7 +56,8 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
              seed: int = 0, workers: int | None = 1, store: str | Path | SampleStore | None = None,
              options: Mapping[str, Any] | SparseOptions | None = None, scheduler: Any = None,
              progress: bool = False, retry_failed: bool = False, tolerances: Any = None,
-             log: Callable[[str], None] | None = None, x0: Any = None, max_violation: float = 0.01) -> OptimizeResult:
+             log: Callable[[str], None] | None = None, x0: Any = None, max_violation: float = 0.01,
+             stop_after_failures: int | None = DEFAULT_STOP_AFTER_FAILURES) -> OptimizeResult:
     """Minimise a design problem's objective within a budget of simulations.
 
     Parameters
@@ -87,7 +93,7 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
         ``workers`` is then how many designs run at once there: ``workers=None`` for every worker thread of the
         cluster (the default 1 runs one at a time).
     progress : bool
-        Progress bars with rate and ETA.
+        Progress bars; log lines (each tenth of the budget, at least every 30 s) when stderr is not a terminal.
     retry_failed : bool
         Simulate again designs whose earlier simulation failed.
     log : callable, optional
@@ -98,6 +104,8 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
         of as many of its space-filling designs.  Inside the bounds and satisfying the declared constraints.
     tolerances, max_violation : mapping or Tolerances, and float in (0, 0.5), optional
         ``x`` becomes the robust optimum under ± tolerances (``{"oa": 0.1}``): :mod:`mechopt.optimize.analysis.robust`.
+    stop_after_failures : int, optional
+        Stop when the first this-many simulations all failed (default 5; 0 or None: never); later failures do not.
 
     Returns
     -------
@@ -111,19 +119,20 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
     ------
     InputError
         A bad argument, before any simulation.
+    BrokenSimulatorError
+        The first ``stop_after_failures`` simulations all failed (``mechopt.errors``).
     """
     X0, opts, own, tols = _checked(problem, budget, method, seed, workers, store, x0, options, tolerances,
                                    max_violation)
     t0, log = time.perf_counter(), log or (lambda _line: None)
+    stop_after_failures = check_stop_after_failures(stop_after_failures)
     with contextlib.ExitStack() as stack:
         db = _open_store(store, stack)
         executor = stack.enter_context(make_executor(workers=workers, scheduler=scheduler))
         sampler = Sampler(problem, db, executor, progress, retry_failed)
-        result = run_method(problem, method, opts, sampler, log, x0=X0, options=own)
-        if result.get("pipeline") is not None and opts.validation_lines > 0:  # not when handed to auto
-            result["validation"] = validate(result.model, ModelSpace(problem), sampler, opts.validation_lines,
-                                            opts.validation_points, opts.seed, f_min=result.fun)
-            result["trust"] = study_trust(result.stages[0], result.pipeline.best, result.validation)
+        with watch_run(sampler, int(budget), progress=progress, stop_after_failures=stop_after_failures):
+            result = _validated(run_method(problem, method, opts, sampler, log, x0=X0, options=own), problem, opts,
+                                sampler)
         _account(result, sampler)
         make_robust(problem, result, sampler, tols, max_violation, log)
     result["wall_time_s"] = time.perf_counter() - t0
@@ -138,6 +147,16 @@ def _checked(problem: DesignProblem, budget: int, method: Any, seed: int, worker
     X0 = check_x0(problem, x0, int(budget))
     opts, own = _split_options(problem, method, options, int(budget), int(seed), X0)
     return X0, opts, own, checked_robust(problem, tolerances, max_violation)
+
+
+def _validated(result: OptimizeResult, problem: DesignProblem, opts: SparseOptions,
+               sampler: Sampler) -> OptimizeResult:
+    """``result`` with the held-out validation of its line model when asked for (not when handed to auto)."""
+    if result.get("pipeline") is not None and opts.validation_lines > 0:
+        result["validation"] = validate(result.model, ModelSpace(problem), sampler, opts.validation_lines,
+                                        opts.validation_points, opts.seed, f_min=result.fun)
+        result["trust"] = study_trust(result.stages[0], result.pipeline.best, result.validation)
+    return result
 
 
 def _split_options(problem: DesignProblem, method: str | Callable[..., Any],

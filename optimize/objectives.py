@@ -22,7 +22,7 @@ import numpy as np
 
 from mechopt.errors import InputError
 
-__all__ = ["MAX_OBJECTIVES", "Limits", "ObjectiveSpec", "parse_limit", "parse_objective"]
+__all__ = ["MAX_OBJECTIVES", "DeclaredObjectives", "Limits", "ObjectiveSpec", "parse_limit", "parse_objective"]
 
 #: Most objectives a problem may have: a front in more dimensions needs far more designs than a simulator affords.
 MAX_OBJECTIVES = 4
@@ -223,3 +223,31 @@ def parse_limit(text: str) -> tuple[str, tuple[float | None, float | None]]:
     if found is not None and found[0].isidentifier():
         return found
     raise InputError(f"limit {text!r}: {expected}")
+
+
+class DeclaredObjectives:
+    """What a design problem declares it trades off, parsed: its objectives and its limits on simulated outputs.
+
+    A base of :class:`~mechopt.optimize.problem.DesignProblem`, which sets ``name``, ``outputs``, ``objective`` and
+    ``limits``; parsing raises the one-line :class:`~mechopt.errors.InputError` of a bad declaration.
+    """
+
+    name: str
+    outputs: tuple[str, ...]
+    objective: str | tuple[str, ...]
+    limits: dict[str, tuple[float | None, float | None]]
+
+    @property
+    def objective_spec(self) -> ObjectiveSpec:
+        """The objectives parsed: output names and senses (:func:`parse_objective`)."""
+        return parse_objective(self.objective, self.outputs, f"problem {self.name!r}")
+
+    @property
+    def limit_spec(self) -> Limits:
+        """The limits parsed (:meth:`Limits.parse`)."""
+        return Limits.parse(self.limits, self.outputs, f"problem {self.name!r}")
+
+    @property
+    def trade_off(self) -> bool:
+        """Several objectives or limits on simulated outputs: the method must see every output it reads."""
+        return self.objective_spec.k > 1 or self.limit_spec.m > 0

@@ -33,7 +33,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from mechopt.errors import InputError, MechoptError
-from mechopt.optimize.objectives import Limits, ObjectiveSpec, parse_objective
+from mechopt.optimize.objectives import DeclaredObjectives
 from mechopt.runs.fingerprint import fingerprint
 from mechopt.runs.sample_record import KEY_DECIMALS
 
@@ -126,7 +126,7 @@ def as_design_array(X: Any, dim: int, what: str = "designs") -> np.ndarray:
     return arr
 
 
-class DesignProblem:
+class DesignProblem(DeclaredObjectives):
     """Base class of every design problem (a mechanism study, a test function, a user's simulator).
 
     Subclasses set the class attributes (or instance attributes in ``__init__``) and implement :meth:`evaluate`,
@@ -358,21 +358,6 @@ class DesignProblem:
     def objective_value(self, outputs: Mapping[str, float]) -> float:
         """The (first) objective from an evaluation's outputs, as minimised (a maximised output negated)."""
         return float(self.objective_spec.values(outputs)[0])
-
-    @property
-    def objective_spec(self) -> ObjectiveSpec:
-        """The objectives parsed: output names and senses (:func:`~mechopt.optimize.objectives.parse_objective`)."""
-        return parse_objective(self.objective, self.outputs, f"problem {self.name!r}")
-
-    @property
-    def limit_spec(self) -> Limits:
-        """The limits parsed (:meth:`~mechopt.optimize.objectives.Limits.parse`)."""
-        return Limits.parse(self.limits, self.outputs, f"problem {self.name!r}")
-
-    @property
-    def trade_off(self) -> bool:
-        """Several objectives or limits on simulated outputs: the method must see every output it reads."""
-        return self.objective_spec.k > 1 or self.limit_spec.m > 0
 
     def residual_vector(self, outputs: Mapping[str, Any]) -> np.ndarray:
         """The residual vector of an evaluation's outputs (a least-squares problem; :attr:`residuals`).

@@ -8,6 +8,8 @@ the store's records, the search is :func:`~mechopt.optimize.auto.multi_objective
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from mechopt.errors import InputError
@@ -22,13 +24,25 @@ __all__ = ["check_trade_off_method", "run_trade_off"]
 
 def check_trade_off_method(problem: DesignProblem, method: object) -> None:
     """Refuse, in one line, a method other than ``"auto"`` on several objectives or limits on simulated outputs."""
-    if method == "auto" or not problem.trade_off:
+    from mechopt.optimize.methods import get_method
+
+    if not problem.trade_off or get_method(method).max_objectives > 1:
         return
     spec, limits = problem.objective_spec, problem.limit_spec
     what = f"{spec.k} objectives" if spec.k > 1 else f"limits on simulated outputs ({limits.describe()})"
     name = method if isinstance(method, str) else getattr(method, "__name__", "custom")
     raise InputError(f"method {name!r} takes one objective and no limits on simulated outputs, got {what}; "
                      "expected method 'auto'")
+
+
+class _MissingOutputWatch:
+    """A sampler's watcher: the one-line error of a missing named output, at the first design that lacks it."""
+
+    def __init__(self, problem: DesignProblem) -> None:
+        self.problem = problem
+
+    def record(self, record: Any, cached: bool = False) -> None:
+        _missing_output(self.problem, [record])
 
 
 def _missing_output(problem: DesignProblem, records: list) -> None:
@@ -76,13 +90,9 @@ def run_trade_off(problem: DesignProblem, budget: int, seed: int, sampler, initi
     """
     spec, limits = problem.objective_spec, problem.limit_spec
     outputs: list = []
-    first = [True]
 
     def evaluate(X: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         records = sampler.records(X, desc=desc)
-        if first[0]:
-            first[0] = False
-            _missing_output(problem, records)
         F = np.array([spec.values(r.outputs) if r.ok else np.full(spec.k, np.nan) for r in records])
         G = np.array([limits.values(r.outputs) if r.ok else np.full(limits.m, np.nan) for r in records])
         G = G.reshape(len(records), limits.m)
@@ -94,9 +104,14 @@ def run_trade_off(problem: DesignProblem, budget: int, seed: int, sampler, initi
     def margins(X: np.ndarray) -> np.ndarray:
         return problem.constraint_margins(np.atleast_2d(X))
 
-    run = trade_off_search(evaluate, problem.bounds, budget, spec.k, limits.lower, limits.upper, seed=seed,
-                           feasible=problem.feasible, batch=sampler.batch_size,
-                           margins=margins if problem.constraints else None, initial=initial)
+    watch = _MissingOutputWatch(problem)
+    sampler.watchers.append(watch)  # at the first design that lacks one, before a broken-simulator stop
+    try:
+        run = trade_off_search(evaluate, problem.bounds, budget, spec.k, limits.lower, limits.upper, seed=seed,
+                               feasible=problem.feasible, batch=sampler.batch_size,
+                               margins=margins if problem.constraints else None, initial=initial)
+    finally:
+        sampler.watchers.remove(watch)
     answer = trade_off_answer(problem, run.X, run.F, run.G, run.ok, outputs)
     kind = f"ParEGO on {spec.k} objectives" if spec.k > 1 else "constrained expected improvement"
     limited = f" under limits {limits.describe()}" if limits.m else ""

@@ -13,6 +13,7 @@ from mechopt.errors import InputError
 from mechopt.report.convergence import plot_convergence
 from mechopt.report.plots import plot_feasible_3d, plot_feasible_slices, plot_validation
 from mechopt.report.tolerance_section import tolerance_lines, tolerance_summary
+from mechopt.studies.reference_check import reference_warning
 
 __all__ = ["write_outputs"]
 
@@ -111,6 +112,7 @@ def result_dict(run) -> dict[str, Any]:
         "stages": [s.summary() for s in res.get("stages") or []],
         "history": [float(v) for v in res.get("history") or []],
         "message": res.message,
+        "reference_warning": reference_warning(run.references, obj, float(res.fun), _unit(problem)),
         "trust": res.get("trust"),
         "validation": None if val is None else {
             "rmse": val.rmse, "rmse_low": val.rmse_low, "max_error": val.max_error, "f_min": val.f_min,
@@ -220,6 +222,7 @@ def report_markdown(r: dict[str, Any], study) -> str:
              f"{problem.output_label(obj)} {o['objective']:.6g}"
              + ("" if o["predicted"] is None else f" (model {o['predicted']:.6g})") + ".", "",
              _simulations_sentence(r), "",
+             *([f"**W{r['reference_warning'][1:]}**", ""] if r.get("reference_warning") else []),
              "## Designs", ""]
     lines += _design_table(r, problem, names, units)
     lines += tolerance_lines(r)

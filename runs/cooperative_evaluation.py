@@ -66,6 +66,9 @@ class CooperativeEvaluation:
         See :func:`is_final`.
     lease_s : float
         Lease of this run's claims, s.
+    on_record : callable, optional
+        ``on_record(record)`` for each design settled by :meth:`run`, as it is settled; what it raises ends the run
+        (the early stop of a broken simulator).
 
     Attributes
     ----------
@@ -88,6 +91,7 @@ class CooperativeEvaluation:
         n_cached: int,
         redo_failed_before: str | None,
         lease_s: float,
+        on_record: Callable[[SampleRecord], None] | None = None,
     ) -> None:
         self.store = store
         self.fingerprint = fingerprint
@@ -96,6 +100,7 @@ class CooperativeEvaluation:
         self.n_cached = n_cached
         self.redo_failed_before = redo_failed_before
         self.lease_s = lease_s
+        self.on_record = on_record
         self.owner = new_owner()
         self.counts = {"computed": 0, "waited": 0, "failed": 0, "infeasible": 0}
         self.compute_time_s = 0.0
@@ -179,6 +184,8 @@ class CooperativeEvaluation:
         shown = {k: v for k, v in self.counts.items() if v and k != "computed"}
         self._bar.set_postfix(cached=self.n_cached, **shown, refresh=False)
         self._bar.update(1)
+        if self.on_record is not None:
+            self.on_record(record)
 
     def _claim(self, submitted: set[str], limit: int) -> list[str]:
         """Claim up to ``limit`` pending designs not yet submitted, first in order of preference."""

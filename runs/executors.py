@@ -32,6 +32,8 @@ from typing import Any, TypeVar
 from urllib.parse import urlsplit
 
 from mechopt.errors import InputError, StudyError
+from mechopt.runs.clean_termination import SigtermAsExit, Terminated
+from mechopt.runs.main_guard import check_main_guard, leave_quietly_if_bootstrapping
 from mechopt.runs.worker_processes import mp_context as _mp_context
 from mechopt.runs.worker_processes import start_worker as _start_worker
 from mechopt.runs.worker_processes import warm_up as _warm_up
@@ -158,6 +160,8 @@ class ProcessExecutor(SampleExecutor):
     """
 
     def __init__(self, workers: int, *, prefetch: int = 0) -> None:
+        leave_quietly_if_bootstrapping()
+        check_main_guard(workers)
         self.workers = workers
         self.max_in_flight = workers + prefetch
         self.description = f"{workers} local process{'es' if workers != 1 else ''}"
@@ -167,6 +171,7 @@ class ProcessExecutor(SampleExecutor):
         # Start the workers now, in the background, while the method plans its first designs: on a busy machine a
         # cold start of 8 workers takes seconds, which would otherwise come before the first simulation.
         threading.Thread(target=_warm_up, args=(self._pool, workers), name="mechopt-pool-warm-up", daemon=True).start()
+        self._sigterm = SigtermAsExit()
 
     def map_unordered(self, fn: Callable[[T], R], items: Iterable[T]) -> Iterator[R]:
         """Run ``fn`` over ``items`` in the worker processes (see :meth:`SampleExecutor.map_unordered`).
@@ -215,9 +220,10 @@ class ProcessExecutor(SampleExecutor):
         if self._pool is not None:
             self._pool.shutdown(wait=True, cancel_futures=True)
             self._pool = None
+            self._sigterm.restore()
 
     def __exit__(self, exc_type: type[BaseException] | None, *exc: object) -> None:
-        if exc_type is not None and issubclass(exc_type, KeyboardInterrupt):
+        if exc_type is not None and issubclass(exc_type, KeyboardInterrupt | Terminated):
             self._interrupt_workers()
         self.close()
 

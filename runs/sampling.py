@@ -23,7 +23,7 @@ import functools
 import json
 import math
 import time
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -246,6 +246,7 @@ def sample_designs(
     desc: str = "sampling",
     retry_failed: bool = False,
     lease_s: float = 120.0,
+    on_record: Callable[[SampleRecord], None] | None = None,
 ) -> SamplingResult:
     """Evaluate every design not yet in the store, save each result as it arrives, return all records.
 
@@ -275,6 +276,9 @@ def sample_designs(
     lease_s : float, optional
         Lease of this run's claims, s (default 120): how long another run waits before taking over the designs of
         a run that died without releasing them (on the same host it does not wait for a process that is gone).
+    on_record : callable, optional
+        ``on_record(record)`` for each design this call settles (evaluated here or waited for), as it arrives;
+        what it raises ends the call, with claims released and every result so far stored.
 
     Returns
     -------
@@ -303,7 +307,7 @@ def sample_designs(
     found = {k: r for k, r in store.get_keys(request.unique, fp).items() if is_final(r, redo)}
     pending = {k: d for k, d in request.unique.items() if k not in found}  # neither stored nor given up
     work = CooperativeEvaluation(store, fp, found, pending, n_cached=len(found), redo_failed_before=redo,
-                                 lease_s=lease_s)
+                                 lease_s=lease_s, on_record=on_record)
     if pending:
         work.run(functools.partial(evaluate_one, problem, fp), executor, progress=progress, desc=desc)
     return _sampling_result(request, work, start)

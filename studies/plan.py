@@ -23,6 +23,7 @@ from mechopt.optimize.sparse.space import ModelSpace
 from mechopt.optimize.sparse.stage import planned_designs
 from mechopt.runs.store import SampleStore, design_key
 from mechopt.studies.catalogue import Study
+from mechopt.studies.method_time import method_seconds, method_time_line
 
 __all__ = ["PlanStage", "RunPlan", "duration_text", "open_store_if_any", "plan_run",
            "plan_validation", "seconds_per_run"]
@@ -103,6 +104,8 @@ class RunPlan:
     per_run: float | None
     cost_source: str
     headline: str | None = None
+    #: The method's own computing (s; None: not measured for it), from :mod:`mechopt.studies.method_time`.
+    method_s: float | None = None
 
     @property
     def total(self) -> int:
@@ -148,13 +151,14 @@ class RunPlan:
             f"({self.rounds} rounds × {self.per_run:.3g} s)")
         lines.append(f"  in all: at most {self.total} designs, {self.new} to simulate; expected simulation time {cost} "
                      f"({self.cost_source})")
+        lines.append(method_time_line(self.method_s, self.seconds))
         return lines
 
     def to_dict(self) -> dict:
         """JSON-able plan (``result.json`` → ``plan``)."""
         return {"budget": self.budget, "validation": self.validation, "workers": self.workers,
                 "seconds_per_run": self.per_run, "cost_source": self.cost_source, "total": self.total,
-                "new": self.new, "expected_s": self.seconds, "rounds": self.rounds,
+                "new": self.new, "expected_s": self.seconds, "rounds": self.rounds, "method_s": self.method_s,
                 "stages": [{"name": s.name, "simulations": s.simulations, "held": s.held, "parallel": s.parallel,
                             "exact": s.exact, "rounds": s.rounds(self.workers)} for s in self.stages]}
 
@@ -241,7 +245,8 @@ def plan_run(study: Study, options: SparseOptions, method: str, store: SampleSto
         stages.append(PlanStage(f"reference designs ({', '.join(references)})", len(references),
                                 _held(store, np.vstack(list(references.values())), fingerprint, retry_failed)))
     per_run, source = seconds_per_run(study, store)
-    return RunPlan(stages, budget, validation, workers, per_run, source)
+    return RunPlan(stages, budget, validation, workers, per_run, source,
+                   method_s=method_seconds(method, problem.dim, budget))
 
 
 def _line_stage(study: Study, options: SparseOptions, store: SampleStore | None, retry_failed: bool) -> PlanStage:

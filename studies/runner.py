@@ -8,6 +8,7 @@ Everything a run produces goes to one folder: ``result.json`` (machine-readable)
 
 from __future__ import annotations
 
+import contextlib
 import os
 import time
 from collections.abc import Callable
@@ -28,11 +29,17 @@ from mechopt.optimize.sparse.options import SparseOptions
 from mechopt.optimize.sparse.sampler import Sampler
 from mechopt.optimize.sparse.space import ModelSpace
 from mechopt.optimize.sparse.validate import Validation, validate
+from mechopt.runs.early_stop import DEFAULT_STOP_AFTER_FAILURES
 from mechopt.runs.executors import check_reachable, default_workers, make_executor
 from mechopt.runs.run_journal import RunJournal, describe_run
+from mechopt.runs.run_watch import watch_run
 from mechopt.runs.store import SampleStore
+from mechopt.runs.store_path import check_store_folder
+from mechopt.studies import method_cache
 from mechopt.studies.catalogue import Study
+from mechopt.studies.output_folder import check_output_owner
 from mechopt.studies.plan import RunPlan, duration_text, open_store_if_any, plan_run, plan_validation
+from mechopt.studies.reference_check import reference_warning
 from mechopt.studies.run_header import study_header
 from mechopt.studies.run_options import study_options
 
@@ -87,7 +94,8 @@ def check_output_folder(out: Path) -> Path:
 def run_study(study: Study, out: Path, options: SparseOptions, workers: int | None = None,
               scheduler: str | None = None, store_path: Path | None = None, progress: bool = True,
               truth: bool = False, truth_step: float = 1.0, retry_failed: bool = False,
-              log: Callable[[str], None] = print, method: str = "sparse", x0: np.ndarray | None = None) -> StudyRun:
+              log: Callable[[str], None] = print, method: str = "sparse", x0: np.ndarray | None = None,
+              stop_after_failures: int = DEFAULT_STOP_AFTER_FAILURES, force: bool = False) -> StudyRun:
     """Run the study end to end and write its outputs to ``out``.
 
     Parameters
@@ -117,22 +125,32 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
         available_methods`); held-out validation needs the line model of ``"sparse"``.
     x0 : (m, d) ndarray, optional
         Checked designs simulated first; they count in ``options.budget``, as in :func:`mechopt.minimize`.
+    stop_after_failures : int
+        Stop when the run's first this-many simulations all failed (0: never), as in :func:`mechopt.minimize`.
+    force : bool
+        Use ``out`` even when it holds another study's or another problem's results (they are removed first).
     """
     from mechopt.report.study_report import write_outputs
 
     problem = study.problem
     check_run(study, options, method, scheduler, store_path)
+    if store_path is not None:
+        check_store_folder(store_path)
+    check_output_owner(out, study.name, problem.fingerprint(), force)
     out = check_output_folder(out)
     store_path = Path(store_path) if store_path else out / "samples.sqlite"
     timings: dict[str, float] = {}
     t_all = time.perf_counter()
-    with SampleStore(store_path) as store, make_executor(workers=workers, scheduler=scheduler) as executor:
+    with SampleStore(store_path) as store, make_executor(workers=workers, scheduler=scheduler) as executor, \
+            contextlib.ExitStack() as watching:
         sampler = Sampler(problem, store, executor, progress, retry_failed)
         plan = plan_run(study, options, method, store, executor.workers, retry_failed)
         journal, log = _announce(study, store, store_path, sampler, plan, method, out, log)
+        watching.enter_context(watch_run(sampler, plan.total, progress=progress,
+                                         stop_after_failures=stop_after_failures,
+                                         retry_hint=_retry_hint(store_path)))
         t0 = time.perf_counter()
-        share = options if x0 is None else checked_options(problem, method, options, options.budget, options.seed, x0)
-        result = run_method(problem, method, share, sampler, log, x0=x0)
+        result = _optimise(problem, method, options, sampler, log, x0, out)
         make_study_robust(study, result, sampler, log)
         timings["optimise_s"] = time.perf_counter() - t0
         n_opt = len(sampler.designs)
@@ -153,6 +171,7 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
         sampling = {**sampler.summary(), "optimisation": n_opt, "validation": n_val,
                     "references": len(sampler.designs) - n_opt - n_val, "optimisation_timing": timing}
         failures = [(np.array(d), e) for d, e in sampler.failures.values()]
+        watching.close()  # the last progress line
     ground = _ground_truth(problem, out, truth, truth_step, timings)
     _line_model_verdict(result, validation, n_opt, log)
     result.update(validation=validation, outputs=references["optimum"]["outputs"])
@@ -176,6 +195,25 @@ def _announce(study: Study, store: SampleStore, store_path: Path, sampler: Sampl
     journal = RunJournal(store_path, sampler.fingerprint, study.name,
                          describe_run(study.problem, plan, method, opening, out, store.count(sampler.fingerprint)))
     return journal, journal.tee(log)
+
+
+def _retry_hint(store_path: Path) -> str:
+    return f"--retry-failed (retry_failed=True) simulates them again (they are recorded in {store_path})"
+
+
+def _optimise(problem, method: str, options: SparseOptions, sampler: Sampler, log: Callable[[str], None],
+              x0: np.ndarray | None, out: Path) -> OptimizeResult:
+    """The method's answer: replayed when every design it asked for is stored unchanged, else computed and kept."""
+    share = options if x0 is None else checked_options(problem, method, options, options.budget, options.seed, x0)
+    key = method_cache.run_key(problem, method, share, x0, sampler.batch_size)
+    result = method_cache.replay(out, key, sampler)
+    if result is None:
+        result = run_method(problem, method, share, sampler, log, x0=x0)
+        method_cache.save(out, key, sampler, result)
+    else:
+        log(f"  {method}: every one of its {len(sampler.designs)} simulations is in the store, unchanged: its "
+            f"answer is replayed from {out / method_cache.CACHE_FILE}")
+    return result
 
 
 def plan_study(study: Study, options: SparseOptions, workers: int | None = None, scheduler: str | None = None,
@@ -310,7 +348,8 @@ def summary_lines(run: StudyRun) -> list[str]:
                      f"{problem.describe(np.array(run.truth.x))}, {obj} {run.truth.fun:.6g}; gap "
                      f"{100 * (run.result.fun / run.truth.fun - 1):+.2f} %")
     lines.append(_simulations_line(run))
-    return lines
+    warning = reference_warning(run.references, obj, float(run.result.fun), dict(problem.output_units).get(obj, ""))
+    return lines if warning is None else [*lines, warning]
 
 
 def _simulations_line(run: StudyRun) -> str:

@@ -44,6 +44,8 @@ class Sampler:
             store.forget_failed(self.fingerprint)
         #: Canonical keys of the distinct designs this run asked for (float noise below 1e-9 is one design).
         self.designs: set[str] = set()
+        #: The same designs, by key, in the order first asked for.
+        self.asked: dict[str, tuple[float, ...]] = {}
         self.n_computed = 0
         self.n_cached = 0
         self.n_waited = 0
@@ -57,6 +59,10 @@ class Sampler:
         self.waves = 0
         #: Seconds the simulators spent on the designs this run dispatched (their recorded wall times summed).
         self.busy_s = 0.0
+        #: Watchers of the run (:mod:`mechopt.runs.run_watch`): ``watcher.record(record, cached)`` once per distinct
+        #: design, as it arrives.
+        self.watchers: list = []
+        self._watched: set[str] = set()
         self._started = time.perf_counter()
 
     @property
@@ -78,7 +84,9 @@ class Sampler:
         first_time = len(set(keys) - self.designs)
         t0 = time.perf_counter()
         res = sample_designs(asked, self.problem, self.store, fingerprint=self.fingerprint, executor=self.executor,
-                             progress=self.progress, desc=desc)
+                             progress=self.progress, desc=desc, on_record=self._arrived if self.watchers else None)
+        for record in res.records:  # found in the store: watched once the call is over
+            self._arrived(record, cached=True)
         self.sampling_time_s += time.perf_counter() - t0
         if res.n_computed + res.n_waited > 0:
             self.rounds += 1
@@ -90,9 +98,17 @@ class Sampler:
         self.n_cached += max(0, first_time - res.n_computed - res.n_waited)
         for key, d, r in zip(keys, asked, res.records, strict=True):
             self.designs.add(key)
+            self.asked.setdefault(key, d)
             if r.status == "failed":
                 self.failures[key] = (d, r.error or "failed")
         return list(res.records)
+
+    def _arrived(self, record: SampleRecord, cached: bool = False) -> None:
+        if record.key in self._watched or not self.watchers:
+            return
+        self._watched.add(record.key)
+        for watcher in self.watchers:
+            watcher.record(record, cached)
 
     def __call__(self, designs: np.ndarray, desc: str) -> np.ndarray:
         """The objective at designs (n, d); NaN where the simulation did not succeed."""

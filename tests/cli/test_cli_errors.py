@@ -278,8 +278,13 @@ def test_a_study_whose_every_simulation_fails_and_one_whose_line_model_hands_ove
     for method in ("auto", "sparse"):
         proc = mechopt("study", "vc/study.toml", "--method", method, "--budget", "10", "--workers", "1",
                        "--no-progress", "--out", method, cwd=tmp_path)
-        one_line(proc, "vc-broken: none of the 10 simulations succeeded, the first failed with: SimulatorFailure: "
-                 "exit code 2", "nosuch.py", f"recorded in {method}/samples.sqlite")
+        one_line(proc, "the first 5 simulations all failed, the first with: SimulatorFailure: exit code 2",
+                 "nosuch.py", f"recorded in {method}/samples.sqlite", "--retry-failed")
+    # Without the early stop the whole budget is spent, and the study says so in one line too.
+    proc = mechopt("study", "vc/study.toml", "--method", "auto", "--budget", "10", "--workers", "1",
+                   "--no-progress", "--out", "all", "--stop-after-failures", "0", cwd=tmp_path)
+    one_line(proc, "vc-broken: none of the 10 simulations succeeded, the first failed with: SimulatorFailure: "
+             "exit code 2", "nosuch.py", "recorded in all/samples.sqlite")
     # Some simulations fail: the line model hands over to auto, and the study writes its report.
     proc = mechopt("study", "failing_hartmann3", "--method", "sparse", "--budget", "60", "--workers", "1",
                    "--no-progress", "--out", "fh", cwd=tmp_path)

@@ -37,7 +37,7 @@ def test_a_run_whose_every_simulation_fails_says_why():
         def evaluate(self, x):
             return float(x[0])
 
-    r = mechopt.minimize(Wrong(), 10, seed=0)
+    r = mechopt.minimize(Wrong(), 10, seed=0, stop_after_failures=0)
     assert not r.success and r.nfailed == 10 == len(r.failures)
     assert "the first with: evaluate returned float, expected a dict with outputs ['f']" in r.message
     assert all(5.0 <= x[0] <= 40.0 and "evaluate returned float" in why for x, why in r.failures)

@@ -436,7 +436,8 @@ def test_a_terminal_ctrl_c_is_left_to_the_main_process(tmp_path):
 
 
 def test_a_script_that_starts_workers_without_a_main_guard_is_told_why_they_died(tmp_path):
-    # Each worker process re-runs an unguarded script's top level, and Python stops it at start: the pool breaks.
+    # Each worker process would re-run an unguarded script's top level, and Python would stop it at start: the
+    # script is told so in one line before any worker starts (issue 52; tests/runs/test_worker_startup.py).
     script = tmp_path / "unguarded.py"
     script.write_text(
         "import mechopt\n"
@@ -446,6 +447,6 @@ def test_a_script_that_starts_workers_without_a_main_guard_is_told_why_they_died
     proc = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120,
                           cwd=tmp_path)
     assert proc.returncode != 0
-    last = proc.stderr.strip().splitlines()[-1]
-    assert last.startswith("mechopt.errors.StudyError: a worker process died")
-    assert 'if __name__ == "__main__":' in last
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("mechopt: error: workers = 2 start processes"), proc.stderr
+    assert 'if __name__ == "__main__":' in lines[0]
