@@ -17,7 +17,7 @@ from mechopt.errors import InputError
 
 __all__ = ["OUTPUT_FILES", "check_output_owner"]
 
-#: What a study run writes into its output folder (figures/*.png besides).
+#: What a study run writes into its output folder (``figures/*.png`` besides).
 OUTPUT_FILES = ("result.json", "report.md", "model.json", "front.csv", "method_cache.pickle")
 
 
