@@ -67,15 +67,8 @@ def minimize(problem: DesignProblem, budget: int = 600, method: str | Callable[.
     budget : int
         Most simulations the method may ask for (validation simulations of the sparse method come on top).
     method : str or callable
-        ``"auto"`` (default: a plan chosen by dimension, budget and the problem's declaration, 2 to 12 variables,
-        budgets from 2d + 2: Gaussian-process steps, in trust regions beyond 300 designs, or Gauss-Newton runs on the
-        residuals of a least-squares problem; failed simulations learned and avoided; :mod:`mechopt.optimize.auto`),
-        ``"sparse"`` (the line-sampled sparse model of paper 002, then a local search on the simulator; 2 to 4
-        variables),
-        ``"sparse-global"`` (for multimodal objectives: the lines' blend, its basins, then steps on the blend
-        corrected by every simulation; :mod:`mechopt.optimize.sparse_global`), a
-        baseline's name (``"slsqp"``, ``"differential_evolution"``...) or a callable
-        ``f(counted_problem, seed) -> scipy OptimizeResult``.
+        A name of the table of methods (:mod:`mechopt.optimize.methods`; ``mechopt methods`` lists each with what
+        it takes), ``"auto"`` by default, or a callable ``f(counted_problem, seed) -> scipy OptimizeResult``.
     seed : int
         Seed of every random choice.
     workers : int, optional

@@ -133,12 +133,7 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
     from mechopt.report.study_report import write_outputs
 
     problem = study.problem
-    check_run(study, options, method, scheduler, store_path)
-    if store_path is not None:
-        check_store_folder(store_path)
-    check_output_owner(out, study.name, problem.fingerprint(), force)
-    out = check_output_folder(out)
-    store_path = Path(store_path) if store_path else out / "samples.sqlite"
+    out, store_path = _checked_places(study, out, options, method, scheduler, store_path, force)
     timings: dict[str, float] = {}
     t_all = time.perf_counter()
     with SampleStore(store_path) as store, make_executor(workers=workers, scheduler=scheduler) as executor, \
@@ -159,18 +154,8 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
         result.update(parallel_accounting(sampler), history=[value for _, value in sampler.history.values()])
         log(f"  {_optimised_line(result)}; {rounds_text(timing)}")
         _check_some_succeeded(study, result, sampler, store_path)
-        validation = _validate(result, problem, options, sampler, timings, log)
-        n_val = len(sampler.designs) - n_opt
-        if result.model is not None:
-            result.model.save(out / "model.json")
-        t0 = time.perf_counter()
-        references = _references(study, result.x, sampler)
-        timings["references_s"] = time.perf_counter() - t0
-        # The rounds, waiting and computing of the whole run (validation and references included) and, apart, of
-        # the optimisation alone.
-        sampling = {**sampler.summary(), "optimisation": n_opt, "validation": n_val,
-                    "references": len(sampler.designs) - n_opt - n_val, "optimisation_timing": timing}
-        failures = [(np.array(d), e) for d, e in sampler.failures.values()]
+        validation, references, sampling, failures = _validate_and_reference(study, result, options, sampler,
+                                                                             timings, log, out, n_opt, timing)
         watching.close()  # the last progress line
     ground = _ground_truth(problem, out, truth, truth_step, timings)
     _line_model_verdict(result, validation, n_opt, log)
@@ -183,6 +168,37 @@ def run_study(study: Study, out: Path, options: SparseOptions, workers: int | No
     timings["report_s"] = time.perf_counter() - t0
     journal.finish()
     return run
+
+
+def _checked_places(study: Study, out: Path, options: SparseOptions, method: str, scheduler: str | None,
+                    store_path: Path | None, force: bool) -> tuple[Path, Path]:
+    """The run's arguments checked, and its output folder and store, before any simulation."""
+    check_run(study, options, method, scheduler, store_path)
+    if store_path is not None:
+        check_store_folder(store_path)
+    check_output_owner(out, study.name, study.problem.fingerprint(), force)
+    out = check_output_folder(out)
+    return out, Path(store_path) if store_path else out / "samples.sqlite"
+
+
+def _validate_and_reference(study: Study, result: OptimizeResult, options: SparseOptions, sampler: Sampler,
+                            timings: dict[str, float], log: Callable[[str], None], out: Path, n_opt: int,
+                            timing: dict[str, Any]) -> tuple[Validation | None, dict, dict, list]:
+    """After the optimisation: the held-out validation, the model saved, the reference designs simulated, and the
+    accounting of the whole run's simulations and failures."""
+    validation = _validate(result, study.problem, options, sampler, timings, log)
+    n_val = len(sampler.designs) - n_opt
+    if result.model is not None:
+        result.model.save(out / "model.json")
+    t0 = time.perf_counter()
+    references = _references(study, result.x, sampler)
+    timings["references_s"] = time.perf_counter() - t0
+    # The rounds, waiting and computing of the whole run (validation and references included) and, apart, of
+    # the optimisation alone.
+    sampling = {**sampler.summary(), "optimisation": n_opt, "validation": n_val,
+                "references": len(sampler.designs) - n_opt - n_val, "optimisation_timing": timing}
+    failures = [(np.array(d), e) for d, e in sampler.failures.values()]
+    return validation, references, sampling, failures
 
 
 def _announce(study: Study, store: SampleStore, store_path: Path, sampler: Sampler, plan: RunPlan, method: str,
