@@ -24,20 +24,19 @@ Example
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
 
 from mechopt.errors import InputError, MechoptError
+from mechopt.optimize.allowed_designs import AllowedDesigns
 from mechopt.optimize.objectives import DeclaredObjectives
+from mechopt.optimize.variable import MIN_SPAN, Variable
 from mechopt.runs.fingerprint import fingerprint
-from mechopt.runs.sample_record import KEY_DECIMALS
 
-__all__ = ["FITS", "DesignProblem", "Variable", "as_design_array"]
+__all__ = ["FITS", "MIN_SPAN", "DesignProblem", "Variable", "as_design_array"]
 
 #: What the sparse model fits along its lines: the objective itself, or its square (smoother for an RMS value).
 FITS = ("value", "square")
@@ -45,58 +44,6 @@ FITS = ("value", "square")
 
 #: Designs :meth:`DesignProblem.check_region` spreads over the box to find a feasible one.
 REGION_PROBES = 2**14
-
-#: Narrowest range of a variable, in its unit: a thousand steps of the sample store's resolution.
-MIN_SPAN = 10.0 ** (3 - KEY_DECIMALS)
-
-
-@dataclass(frozen=True)
-class Variable:
-    """One design variable.
-
-    Parameters
-    ----------
-    name : str
-        Identifier used everywhere a user sees a design (CLI, result.json, reports, axis labels), e.g. ``"oa"``.
-    lower, upper : float
-        Bounds of the region of interest, in ``unit``.
-    unit : str
-        Unit of the variable (``"mm"``, ``"rad"``, ``""`` for a ratio).
-    label : str
-        Symbol for plots and tables (``"|OA|"``); default the name.
-    """
-
-    name: str
-    lower: float
-    upper: float
-    unit: str = ""
-    label: str = ""
-
-    def __post_init__(self) -> None:
-        if not isinstance(self.name, str) or not self.name.isidentifier():
-            raise InputError(f"variable name {self.name!r}: expected an identifier such as 'oa'")
-        for key in ("lower", "upper"):
-            value = getattr(self, key)
-            if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-                raise InputError(f"variable {self.name}: {key} = {value!r} must be a finite number")
-        if not self.lower < self.upper:
-            raise InputError(f"variable {self.name}: bounds [{self.lower}, {self.upper}] must satisfy lower < upper")
-        span = self.upper - self.lower
-        if round(span, KEY_DECIMALS) < MIN_SPAN:
-            # The sample store tells designs apart to KEY_DECIMALS decimals: a narrower range would hold too few
-            # distinct designs, and a method's steps would land on designs it has already simulated.
-            raise InputError(f"variable {self.name}: bounds [{self.lower!r}, {self.upper!r}] span {span:.3g}, "
-                             f"expected at least {MIN_SPAN:g} {self.unit} (the sample store resolves "
-                             f"{10.0**-KEY_DECIMALS:g}): state the variable in a smaller unit")
-        object.__setattr__(self, "lower", float(self.lower))
-        object.__setattr__(self, "upper", float(self.upper))
-
-    @property
-    def axis_label(self) -> str:
-        """``label (unit)`` for a plot axis."""
-        text = self.label or self.name
-        return f"{text} ({self.unit})" if self.unit else text
-
 
 def as_design_array(X: Any, dim: int, what: str = "designs") -> np.ndarray:
     """Validate designs and return them as a float array of shape (n, dim).
@@ -126,7 +73,7 @@ def as_design_array(X: Any, dim: int, what: str = "designs") -> np.ndarray:
     return arr
 
 
-class DesignProblem(DeclaredObjectives):
+class DesignProblem(DeclaredObjectives, AllowedDesigns):
     """Base class of every design problem (a mechanism study, a test function, a user's simulator).
 
     Subclasses set the class attributes (or instance attributes in ``__init__``) and implement :meth:`evaluate`,
