@@ -7,9 +7,8 @@ from a move it has not sampled near.  A quadratic with every cross term holds th
 direction's curvature: its Hessian's eigenvectors are the valley's axes, its eigenvalues their curvatures.
 
 With ``p = (d + 1)(d + 2)/2`` designs or more, the model is the least-squares fit of every coefficient (an
-interpolation at exactly p well-placed designs: a quadratic objective is recovered exactly).  With fewer (but at
-least d + 1) it interpolates them with the Hessian of least Frobenius norm (Powell 2004, the first model of NEWUOA):
-the linear part is fixed by the designs, and the curvature is the least the designs require.
+interpolation at exactly p well-placed designs: a quadratic objective is recovered exactly).  Its leave-one-out
+R² (:func:`leave_one_out_r2`) says whether a quadratic describes the designs at all.
 """
 
 from __future__ import annotations
@@ -19,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import minimize
 
-__all__ = ["QuadraticModel", "fit_quadratic", "n_coefficients"]
+__all__ = ["QuadraticModel", "fit_quadratic", "leave_one_out_r2", "n_coefficients"]
 
 
 def n_coefficients(dim: int) -> int:
@@ -83,7 +82,7 @@ def fit_quadratic(U: np.ndarray, values: np.ndarray, centre: np.ndarray) -> Quad
     Parameters
     ----------
     U : (m, d) ndarray
-        Designs (unit cube); m >= d + 1.
+        Designs (unit cube); m >= (d + 1)(d + 2)/2.
     values : (m,) ndarray
         Their finite objective values.
     centre : (d,) ndarray
@@ -92,46 +91,56 @@ def fit_quadratic(U: np.ndarray, values: np.ndarray, centre: np.ndarray) -> Quad
     Returns
     -------
     QuadraticModel or None
-        None when the designs are too few (m < d + 1) or fix no linear model (all on a hyperplane).
+        None when the designs are fewer than the coefficients or fix no linear model (all on a hyperplane).
     """
     U, values, centre = np.atleast_2d(U), np.asarray(values, float), np.asarray(centre, float)
     m, d = U.shape
-    if m < d + 1:
-        return None
     # Centred and scaled to a unit radius: the columns z, z² then have comparable sizes in a small trust region.
     radius = float(np.max(np.abs(U - centre))) or 1.0
     Z = (U - centre) / radius
     shift = float(np.median(values))
     f = values - shift
     A, Q, pairs = _basis(Z)
-    if m >= A.shape[1] + Q.shape[1]:
-        coef, *_ = np.linalg.lstsq(np.hstack([A, Q]), f, rcond=1e-12)
-        linear, curvature = coef[: d + 1], coef[d + 1:]
-    else:
-        solved = _least_frobenius(A, Q, pairs, f)
-        if solved is None:
-            return None
-        linear, curvature = solved
+    if m < A.shape[1] + Q.shape[1] or np.linalg.matrix_rank(A) < A.shape[1]:
+        return None
+    coef, *_ = np.linalg.lstsq(np.hstack([A, Q]), f, rcond=1e-12)
+    linear, curvature = coef[: d + 1], coef[d + 1:]
     H = np.zeros((d, d))
     H[pairs[0], pairs[1]] = curvature
     H = H + np.triu(H, 1).T
     return QuadraticModel(centre, float(linear[0] + shift), linear[1:] / radius, H / radius**2)
 
 
-def _least_frobenius(A: np.ndarray, Q: np.ndarray, pairs: np.ndarray,
-                     f: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
-    """Linear coefficients and curvature columns' coefficients of the interpolant whose Hessian has the least
-    Frobenius norm (an off-diagonal entry counts twice: it appears twice in the matrix).
+def leave_one_out_r2(U: np.ndarray, values: np.ndarray, centre: np.ndarray) -> float:
+    """The share of the values' variance the least-squares quadratic predicts for each design left out of its fit:
+    1 − PRESS / Σ (f − f̄)², PRESS the sum of the leave-one-out residuals e_i / (1 − h_ii) (Allen 1974).
 
-    The KKT system of min ‖W^½ h‖² subject to A c + Q h = f: with B = Q W^-½, h = W^-½ Bᵀλ and
-    [[B Bᵀ, A], [Aᵀ, 0]] [λ; c] = [f; 0] (Powell 2004, Section 2).
+    Parameters
+    ----------
+    U : (m, d) ndarray
+        Designs (unit cube).
+    values : (m,) ndarray
+        Their finite values.
+    centre : (d,) ndarray
+        Design the basis is centred on.
+
+    Returns
+    -------
+    float
+        1 for a quadratic objective, near or below 0 where no quadratic describes the designs; NaN when there are
+        not more designs than coefficients (an interpolation predicts nothing left out).
     """
-    m, k = A.shape
-    if np.linalg.matrix_rank(A) < k:
-        return None
-    weight = np.where(pairs[0] == pairs[1], 1.0, 2.0)
-    B = Q / np.sqrt(weight)
-    K = np.block([[B @ B.T, A], [A.T, np.zeros((k, k))]])
-    sol, *_ = np.linalg.lstsq(K, np.concatenate([f, np.zeros(k)]), rcond=1e-13)
-    lam, linear = sol[:m], sol[m:]
-    return linear, (B.T @ lam) / np.sqrt(weight)
+    U, values = np.atleast_2d(U), np.asarray(values, float)
+    m, d = U.shape
+    if m <= n_coefficients(d):
+        return float("nan")
+    radius = float(np.max(np.abs(U - centre))) or 1.0
+    A, Q, _ = _basis((U - centre) / radius)
+    X = np.hstack([A, Q])
+    # The hat matrix's diagonal from a thin QR (rank-revealing enough for a basis centred and scaled as here).
+    Qr, _ = np.linalg.qr(X)
+    h = np.sum(Qr * Qr, axis=1)
+    coef, *_ = np.linalg.lstsq(X, values, rcond=1e-12)
+    loo = (values - X @ coef) / np.maximum(1.0 - h, 1e-12)
+    total = float(np.sum((values - values.mean()) ** 2))
+    return 1.0 - float(loo @ loo) / total if total > 0 else float("nan")

@@ -18,7 +18,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from mechopt.optimize.auto.quadratic_model import fit_quadratic, n_coefficients
+from mechopt.optimize.auto.quadratic_model import fit_quadratic, leave_one_out_r2, n_coefficients
 
 __all__ = ["QuadraticSteps"]
 
@@ -28,6 +28,10 @@ START_RADIUS = 0.1
 MIN_RADIUS, MAX_RADIUS = 1e-6, 0.5
 #: Expected-improvement steps between two quadratic steps while they improve.
 SUCCESS_WAIT = 1
+#: Least leave-one-out R² of the quadratic on the designs nearest the incumbent for a step to be taken.
+ADEQUATE_R2 = 0.9
+#: Designs the model is fitted to, per coefficient.
+DESIGNS_PER_COEFFICIENT = 2
 
 
 class QuadraticSteps:
@@ -69,7 +73,11 @@ class QuadraticSteps:
             return none
         best = ok[int(np.argmin(values[ok]))]
         centre = U[best]
-        near = ok[np.argsort(np.max(np.abs(U[ok] - centre), axis=1))[: n_coefficients(self.dim)]]
+        near = ok[np.argsort(np.max(np.abs(U[ok] - centre), axis=1))[: DESIGNS_PER_COEFFICIENT
+                                                                      * n_coefficients(self.dim)]]
+        if not leave_one_out_r2(U[near], values[near], centre) >= ADEQUATE_R2:
+            # No quadratic describes the designs near the incumbent (yet): the GP's steps explore.
+            return none
         model = fit_quadratic(U[near], values[near], centre)
         if model is None:
             return none

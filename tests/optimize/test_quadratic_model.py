@@ -1,9 +1,10 @@
 """The full quadratic model of the default method's trust-region steps against known answers."""
 
 import numpy as np
+import pytest
 from scipy.stats import special_ortho_group
 
-from mechopt.optimize.auto.quadratic_model import fit_quadratic, n_coefficients
+from mechopt.optimize.auto.quadratic_model import fit_quadratic, leave_one_out_r2, n_coefficients
 
 
 def _rotated_quadratic(d: int, seed: int):
@@ -28,29 +29,27 @@ def test_least_squares_recovers_a_rotated_ill_conditioned_hessian():
     np.testing.assert_allclose(model(U), f(U), rtol=1e-8)
 
 
-def test_least_frobenius_interpolates_and_matches_the_closed_form():
-    # d + 2 designs in 2-D: the interpolant whose Hessian has the least Frobenius norm, checked against a direct
-    # minimisation of that norm over every interpolating quadratic (scipy's SLSQP on the 6 coefficients).
-    from scipy.optimize import minimize
-
-    rng = np.random.default_rng(3)
-    d, centre = 2, np.array([0.4, 0.6])
-    U = centre + 0.2 * rng.uniform(-1, 1, (4, d))
-    f = np.sin(3 * U[:, 0]) + U[:, 1] ** 3
-    model = fit_quadratic(U, f, centre)
-    np.testing.assert_allclose(model(U), f, atol=1e-10)
-
-    def interp(c):
-        S = U - centre
-        return c[0] + S @ c[1:3] + 0.5 * (c[3] * S[:, 0] ** 2 + 2 * c[4] * S[:, 0] * S[:, 1] + c[5] * S[:, 1] ** 2) - f
-
-    res = minimize(lambda c: c[3] ** 2 + 2 * c[4] ** 2 + c[5] ** 2, np.zeros(6), method="SLSQP",
-                   constraints=[{"type": "eq", "fun": interp}], options={"ftol": 1e-14, "maxiter": 500})
-    np.testing.assert_allclose(model.hessian, [[res.x[3], res.x[4]], [res.x[4], res.x[5]]], atol=1e-6)
+def test_leave_one_out_r2_matches_refits_and_tells_a_quadratic_from_noise():
+    d = 3
+    H, xs, f = _rotated_quadratic(d, 4)
+    rng = np.random.default_rng(5)
+    centre = np.full(d, 0.5)
+    U = centre + 0.3 * rng.uniform(-1, 1, (2 * n_coefficients(d), d))
+    assert leave_one_out_r2(U, f(U), centre) == pytest.approx(1.0, abs=1e-9)
+    noise = rng.random(U.shape[0])
+    # The closed form against brute force: each design left out of its own least-squares refit.
+    loo = []
+    for i in range(U.shape[0]):
+        keep = np.arange(U.shape[0]) != i
+        loo.append(noise[i] - fit_quadratic(U[keep], noise[keep], centre)(U[i:i + 1])[0])
+    brute = 1.0 - np.sum(np.square(loo)) / np.sum((noise - noise.mean()) ** 2)
+    assert leave_one_out_r2(U, noise, centre) == pytest.approx(brute, rel=1e-8)
+    assert brute < 0.0
+    assert np.isnan(leave_one_out_r2(U[: n_coefficients(d)], noise[: n_coefficients(d)], centre))
 
 
 def test_too_few_designs_give_no_model():
-    assert fit_quadratic(np.zeros((2, 3)), np.zeros(2), np.zeros(3)) is None
-    # d + 1 designs on a line fix no linear model.
-    U = np.outer(np.linspace(0, 1, 4), np.ones(3))
-    assert fit_quadratic(U, np.arange(4.0), U[0]) is None
+    assert fit_quadratic(np.zeros((9, 3)), np.zeros(9), np.zeros(3)) is None
+    # Designs on a line fix no linear model in 3 variables.
+    U = np.outer(np.linspace(0, 1, 12), np.ones(3))
+    assert fit_quadratic(U, np.arange(12.0), U[0]) is None
