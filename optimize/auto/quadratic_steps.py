@@ -1,15 +1,23 @@
 """Trust-region steps of a full quadratic model (:mod:`~mechopt.optimize.auto.quadratic_model`) among the global
-plan's expected-improvement steps, taken as long as they pay.
+plan's expected-improvement steps, taken where a quadratic describes the designs and as long as they pay.
 
-The step is the model's minimiser in a box of half-edge ``radius`` around the incumbent, the model fitted to the
-(d + 1)(d + 2)/2 designs nearest it.  The radius follows Powell's ratio test: the reduction achieved over the
-reduction the model predicted; above 3/4 with the step at the box's edge the box doubles, below 1/4 it halves.
+The step is the model's minimiser in a box of half-edge ``radius`` around the incumbent, the model fitted by least
+squares to the 2p designs nearest it (p = (d + 1)(d + 2)/2 coefficients).  The radius follows Powell's ratio test:
+the reduction achieved over the reduction the model predicted; above 3/4 with the step at the box's edge the box
+doubles, below 1/4 it halves.
 
-Whether the landscape is a valley the quadratic describes is learned from the steps themselves, not assumed: a step
-that improves the incumbent is followed by another after the next expected-improvement step; after the j-th
-consecutive step that did not, the next waits 2^j expected-improvement steps.  On a landscape no quadratic
-describes (many wells, a plateau) the steps then cost about log2 of the budget; on a valley they take every other
-design, and the expected-improvement steps between them keep the search global and the fitted designs spread.
+Whether the landscape near the incumbent is a valley the quadratic describes is learned, not assumed, in two ways:
+
+* the model is used only where it predicts the designs it is fitted to, each left out in turn, with R² >= 0.9.
+  Early in a run, or on a landscape of many wells, the nearest designs span several basins and no quadratic
+  predicts them: the GP's expected improvement keeps exploring (a step whenever the last one paid, without this
+  test, settled Styblinski-Tang and the cosine bowl into the basin of their first incumbent);
+* a step that improves the incumbent is followed by another after the next expected-improvement step; after the
+  j-th consecutive step that did not, the next waits 2^j expected-improvement steps, so that steps that do not pay
+  cost about log2 of the budget.
+
+On a valley the steps then take every other design, and the expected-improvement steps between them keep the search
+global and the fitted designs spread.
 """
 
 from __future__ import annotations
@@ -30,7 +38,8 @@ MIN_RADIUS, MAX_RADIUS = 1e-6, 0.5
 SUCCESS_WAIT = 1
 #: Least leave-one-out R² of the quadratic on the designs nearest the incumbent for a step to be taken.
 ADEQUATE_R2 = 0.9
-#: Designs the model is fitted to, per coefficient.
+#: Designs the model is fitted to, per coefficient (at most; at least d + 1 more than the coefficients, so that
+#: the leave-one-out test has designs to spare).
 DESIGNS_PER_COEFFICIENT = 2
 
 
@@ -69,13 +78,14 @@ class QuadraticSteps:
             self.wait -= 1
             return none
         ok = np.flatnonzero(np.isfinite(values))
-        if ok.size < self.dim + 2:
+        if not ok.size:
             return none
         best = ok[int(np.argmin(values[ok]))]
         centre = U[best]
         near = ok[np.argsort(np.max(np.abs(U[ok] - centre), axis=1))[: DESIGNS_PER_COEFFICIENT
                                                                       * n_coefficients(self.dim)]]
-        if not leave_one_out_r2(U[near], values[near], centre) >= ADEQUATE_R2:
+        if near.size <= n_coefficients(self.dim) + self.dim or not leave_one_out_r2(
+                U[near], values[near], centre) >= ADEQUATE_R2:
             # No quadratic describes the designs near the incumbent (yet): the GP's steps explore.
             return none
         model = fit_quadratic(U[near], values[near], centre)
