@@ -144,6 +144,7 @@ def run_auto(call: MethodCall, budget: int | None = None) -> OptimizeResult:
     """Gaussian-process steps on a plan chosen by dimension and budget (:mod:`mechopt.optimize.auto`), from
     ``call.initial`` when given; ``budget`` overrides the call's (what a handed-over run has left)."""
     from mechopt.optimize.auto import auto_search
+    from mechopt.optimize.auto.design_grid import DesignGrid
 
     problem, sampler = call.problem, call.sampler
 
@@ -156,9 +157,10 @@ def run_auto(call: MethodCall, budget: int | None = None) -> OptimizeResult:
     res = auto_search(evaluate, problem.bounds, call.budget if budget is None else budget, call.seed,
                       feasible=problem.feasible, batch=sampler.batch_size, margins=call.margins(),
                       residuals=residuals if problem.residuals else None, fd_step=problem.fd_step,
-                      initial=call.initial)
-    success = bool(np.all(np.isfinite(res.x)) and problem.feasible(res.x)[0])
-    return OptimizeResult(x=res.x, fun=res.fun, nfev=len(sampler.designs), success=success, message=res.message,
+                      initial=call.initial, grid=DesignGrid.of(problem))
+    x = problem.snap(res.x) if np.all(np.isfinite(res.x)) else res.x  # exactly the allowed design simulated
+    success = bool(np.all(np.isfinite(x)) and problem.feasible(x)[0])
+    return OptimizeResult(x=x, fun=res.fun, nfev=len(sampler.designs), success=success, message=res.message,
                           method=call.name, plan=res.plan.name, model=None, stages=[], validation=None)
 
 
@@ -178,12 +180,14 @@ def run_baseline(call: MethodCall, fn: Callable[..., Any]) -> OptimizeResult:
 
     def margins(X: np.ndarray) -> np.ndarray:
         X = np.asarray(X, dtype=float)
-        M = problem.constraint_margins(np.atleast_2d(X))
+        # The margins of the design that would be simulated: a method's feasibility test agrees with the door.
+        M = problem.constraint_margins(sampler.allowed(X))
         return M[0] if X.ndim == 1 else M
 
     progress, sampler.progress = sampler.progress, False
     counted = CountedProblem(objective, problem.bounds, call.budget, margins if problem.constraints else None,
-                             failure_errors=(InfeasibleDesignError,), vectorized_constraints=True)
+                             failure_errors=(InfeasibleDesignError,), vectorized_constraints=True,
+                             snap=(lambda x: sampler.allowed(x)[0]) if sampler.discrete else None)
     try:
         res = fn(counted, call.seed, **call.options)
     finally:

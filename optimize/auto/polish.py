@@ -12,6 +12,7 @@ from collections.abc import Callable
 import numpy as np
 from scipy.optimize import minimize
 
+from mechopt.optimize.auto.design_grid import DesignGrid
 from mechopt.optimize.auto.gp import GaussianProcess
 
 __all__ = ["nearest_feasible", "polish_on_constraints"]
@@ -19,7 +20,8 @@ __all__ = ["nearest_feasible", "polish_on_constraints"]
 
 def polish_on_constraints(gp: GaussianProcess, centre: np.ndarray, lo: np.ndarray, hi: np.ndarray,
                           margins: Callable[[np.ndarray], np.ndarray],
-                          allowed: Callable[[np.ndarray], np.ndarray]) -> np.ndarray | None:
+                          allowed: Callable[[np.ndarray], np.ndarray],
+                          grid: DesignGrid | None = None) -> np.ndarray | None:
     """The model's constrained minimiser near ``centre`` (unit cube), or None when it is not a new allowed design.
 
     Parameters
@@ -34,12 +36,14 @@ def polish_on_constraints(gp: GaussianProcess, centre: np.ndarray, lo: np.ndarra
         ``margins(U) -> (m, c)`` constraint margins (>= 0 feasible) of designs in unit-cube coordinates.
     allowed : callable
         Designs that may be simulated (declared constraints, not simulated yet).
+    grid : DesignGrid, optional
+        With discrete variables: only the continuous ones move (the discrete ones keep the centre's values).
     """
-    res = minimize(lambda u: float(gp.predict(u[None, :])[0][0]), centre, method="SLSQP",
-                   bounds=list(zip(lo, hi, strict=True)),
+    bounds = list(zip(lo, hi, strict=True)) if grid is None else grid.polish_bounds(centre, lo, hi)
+    res = minimize(lambda u: float(gp.predict(u[None, :])[0][0]), centre, method="SLSQP", bounds=bounds,
                    constraints=[{"type": "ineq", "fun": lambda u: margins(u[None, :])[0]}],
                    options={"maxiter": 100, "ftol": 1e-10})
-    x = np.clip(res.x, lo, hi)
+    x = np.clip(res.x, lo, hi) if grid is None else grid.snap(np.clip(res.x, lo, hi))[0]
     return x if allowed(x[None, :])[0] else None
 
 
