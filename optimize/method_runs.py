@@ -23,7 +23,7 @@ from mechopt.optimize.sparse.pipeline import run_pipeline
 from mechopt.optimize.sparse.sampler import Sampler
 from mechopt.optimize.sparse.space import ModelSpace
 
-__all__ = ["MethodCall", "run_auto", "run_baseline", "run_sparse", "run_sparse_global"]
+__all__ = ["MethodCall", "best_simulated", "run_auto", "run_baseline", "run_sparse", "run_sparse_global"]
 
 
 @dataclass(frozen=True)
@@ -84,8 +84,9 @@ def run_sparse(call: MethodCall) -> OptimizeResult:
         if isinstance(exc, InputError | BrokenSimulatorError) or not sampler.failures:
             raise
         return _handed_to_auto(call, f"the line model could not be built ({exc})")
-    success = bool(np.isfinite(pipeline.fun) and space.feasible(pipeline.x)[0])
-    return OptimizeResult(x=pipeline.x, fun=pipeline.fun, nfev=len(sampler.designs), success=success,
+    x, fun = best_simulated(problem, sampler, pipeline.x, pipeline.fun)
+    success = bool(np.isfinite(fun) and space.feasible(x)[0])
+    return OptimizeResult(x=x, fun=fun, nfev=len(sampler.designs), success=success,
                           message=pipeline.message, method=call.name, model=pipeline.stages[0].model,
                           stages=pipeline.stages, pipeline=pipeline, validation=None, options=opts,
                           trust=study_trust(pipeline.stages[0], pipeline.best, None))
@@ -118,10 +119,26 @@ def run_sparse_global(call: MethodCall) -> OptimizeResult:
         if np.isfinite(run.value) and run.value < fun:
             x, fun = np.asarray(x_ls, dtype=float), float(run.value)
         message += f"; Gauss-Newton on the residuals from its best design: {fun:.6g} ({run.message})"
+    x, fun = best_simulated(problem, sampler, x, fun)
     success = bool(np.all(np.isfinite(x)) and problem.feasible(x)[0])
     return OptimizeResult(x=x, fun=fun, nfev=len(sampler.designs), success=success, message=message,
                           method=call.name, model=None, models=res.models, stages=[], validation=None,
                           trust=trust)
+
+
+def best_simulated(problem: DesignProblem, sampler: Sampler, x: np.ndarray, fun: float) -> tuple[np.ndarray, float]:
+    """With discrete variables, the best feasible design the run simulated (every one is allowed: the sampler snaps
+    them) and its value, instead of a method's own answer, which may be a proposal that was rounded; ``(x, fun)``
+    unchanged when every variable is continuous."""
+    if not sampler.discrete:
+        return x, fun
+    done = [(v, d) for d, v in sampler.history.values() if np.isfinite(v)]
+    X = np.array([d for _, d in done]).reshape(-1, problem.dim)
+    ok = problem.feasible(X) if X.shape[0] else np.zeros(0, dtype=bool)
+    if not ok.any():
+        return problem.snap(x) if np.all(np.isfinite(x)) else x, fun
+    i = int(np.argmin(np.where(ok, [v for v, _ in done], np.inf)))
+    return X[i].copy(), float(done[i][0])
 
 
 def _handed_to_auto(call: MethodCall, why: str) -> OptimizeResult:
