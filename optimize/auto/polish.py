@@ -37,13 +37,19 @@ def polish_on_constraints(gp: GaussianProcess, centre: np.ndarray, lo: np.ndarra
     allowed : callable
         Designs that may be simulated (declared constraints, not simulated yet).
     grid : DesignGrid, optional
-        With discrete variables: only the continuous ones move (the discrete ones keep the centre's values).
+        With discrete variables: the relaxed minimiser's neighbouring allowed designs are ranked by the model's
+        mean, and the best one that may be simulated is returned (rounding the minimiser alone would often leave
+        the constraint it lies on).
     """
-    bounds = list(zip(lo, hi, strict=True)) if grid is None else grid.polish_bounds(centre, lo, hi)
-    res = minimize(lambda u: float(gp.predict(u[None, :])[0][0]), centre, method="SLSQP", bounds=bounds,
+    res = minimize(lambda u: float(gp.predict(u[None, :])[0][0]), centre, method="SLSQP",
+                   bounds=list(zip(lo, hi, strict=True)),
                    constraints=[{"type": "ineq", "fun": lambda u: margins(u[None, :])[0]}],
                    options={"maxiter": 100, "ftol": 1e-10})
-    x = np.clip(res.x, lo, hi) if grid is None else grid.snap(np.clip(res.x, lo, hi))[0]
+    x = np.clip(res.x, lo, hi)
+    if grid is not None:
+        N = grid.neighbourhood(x)
+        N = N[allowed(N)]
+        return N[int(np.argmin(gp.predict(N)[0]))] if N.shape[0] else None
     return x if allowed(x[None, :])[0] else None
 
 

@@ -103,7 +103,7 @@ def _global_plan(run: _Run, plan: Plan) -> None:
         if run.remaining <= plan.n_polish:
             lo, hi = TrustRegion(d, length=POLISH_LENGTH, floor=_floor(run)).box(centre, gp.theta[:d])
             kappa = POLISH_KAPPA
-            if run.margins is not None and (run.grid is None or not run.grid.all_discrete):
+            if run.margins is not None:
                 x = polish_on_constraints(gp, centre, lo, hi, run.unit_margins, run.allowed, run.grid)
                 first = first if x is None else x[None, :]
             if not probed and first.shape[0] < k:
