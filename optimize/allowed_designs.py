@@ -52,3 +52,16 @@ class AllowedDesigns:
             return np.ones(len(X), dtype=bool)
         tol = 10.0 ** -(KEY_DECIMALS - 1)
         return np.all(np.abs(self.snap(X)[:, mask] - X[:, mask]) <= tol, axis=1)
+
+    def space_text(self, budget: int | None = None) -> str:
+        """One line for a plan: the discrete variables' kinds and the number of distinct designs when finite, and
+        whether ``budget`` simulations cover them; empty when every variable is continuous."""
+        if not self.discrete.any():
+            return ""
+        kinds = ", ".join(f"{v.name} {v.describe_kind()}" for v in self.variables if v.discrete)
+        count = self.design_count
+        if count is None:
+            return f"discrete variables: {kinds}; every design simulated lies on them"
+        covered = (f"; the budget of {budget} covers them all: the method may enumerate the space"
+                   if budget is not None and budget >= count else "")
+        return f"discrete variables: {kinds}; {count:,} distinct designs{covered}"
