@@ -86,7 +86,8 @@ class Sampler:
     def allowed(self, designs: np.ndarray) -> np.ndarray:
         """Designs (n, d) moved to their allowed designs (unchanged when every variable is continuous)."""
         designs = np.atleast_2d(np.asarray(designs, dtype=float))
-        return self.problem.snap(designs) if self.discrete else designs
+        # Not clipped: the line model samples beyond the box on purpose, and its samples there must stay apart.
+        return self.problem.snap(designs, clip=False) if self.discrete else designs
 
     def records(self, designs: np.ndarray, desc: str, snap: bool = True) -> list[SampleRecord]:
         """The store's records of the allowed designs of designs (n, d), simulating those it lacks; ``snap=False``
