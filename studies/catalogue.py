@@ -104,19 +104,22 @@ def packaged_studies() -> list[str]:
 def available_studies() -> list[str]:
     """Names of the studies shipped with mechopt (and of the multimodal test functions, for ``mechopt compare``)."""
     from mechopt.studies.benchmark_functions import SUITE
+    from mechopt.studies.mixed_variable_functions import MIXED_SUITE
 
-    return packaged_studies() + sorted(SUITE)
+    return packaged_studies() + sorted(SUITE) + sorted(MIXED_SUITE)
 
 
 def _suite_study(name: str) -> Study | None:
-    """A test function of the multimodal suite as a study (no file: its problem is a class)."""
-    from mechopt.studies import benchmark_functions
+    """A test function of the multimodal or the mixed-variable suite as a study (no file: its problem is a class)."""
+    from mechopt.studies import benchmark_functions, mixed_variable_functions
 
-    cls = benchmark_functions.SUITE.get(name)
-    if cls is None:
-        return None
-    return Study(name=name, path=Path(benchmark_functions.__file__), description=cls.summary(), kind="test-function",
-                 problem=cls())
+    for module, suite in ((benchmark_functions, benchmark_functions.SUITE),
+                          (mixed_variable_functions, mixed_variable_functions.MIXED_SUITE)):
+        cls = suite.get(name)
+        if cls is not None:
+            return Study(name=name, path=Path(module.__file__), description=cls.summary(), kind="test-function",
+                         problem=cls())
+    return None
 
 
 def _resolve(name_or_path: str | Path) -> Path:
