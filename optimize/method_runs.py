@@ -184,6 +184,7 @@ def run_baseline(call: MethodCall, fn: Callable[..., Any]) -> OptimizeResult:
     progress, sampler.progress = sampler.progress, False
     counted = CountedProblem(objective, problem.bounds, call.budget, margins if problem.constraints else None,
                              failure_errors=(InfeasibleDesignError,), vectorized_constraints=True)
+    counted.variables = problem.variables  # the peers declare discrete variables in their libraries' own terms
     try:
         res = fn(counted, call.seed, **call.options)
     finally:
