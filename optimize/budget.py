@@ -85,6 +85,11 @@ class CountedProblem(ConstrainedBox):
         whose proposals are all rejected or cached, which would otherwise never reach the budget.
     vectorized_constraints : bool, default False
         ``constraints`` accepts an array ``(n, d)`` and returns ``(n, m)``; speeds up dense feasibility checks.
+    snap : callable, optional
+        ``snap(x) -> x'``: the allowed design of a proposal (discrete variables' grids, integers, catalogues).
+        Each proposal is moved there before it is keyed and simulated, so two proposals that round alike are one
+        simulation (the second one free); give ``constraints`` of the snapped design too, so that a method's
+        feasibility test agrees with what is simulated.
     """
 
     def __init__(
@@ -101,8 +106,10 @@ class CountedProblem(ConstrainedBox):
         cache: bool = True,
         max_proposals: int | None = None,
         vectorized_constraints: bool = False,
+        snap: Callable[[np.ndarray], np.ndarray] | None = None,
     ) -> None:
         super().__init__(bounds, constraints, vectorized_constraints=vectorized_constraints)
+        self._snap = snap
         if int(budget) != budget or budget < 0:
             raise InputError(f"budget must be a non-negative integer, got {budget!r}")
         self._objective = objective
@@ -164,6 +171,8 @@ class CountedProblem(ConstrainedBox):
             When the (sub-)budget is spent; the objective is then not called.
         """
         x = np.array(x, dtype=float).reshape(self.dim)
+        if self._snap is not None:
+            x = np.array(self._snap(x), dtype=float).reshape(self.dim)
         self._propose()
         key = x.tobytes()
         if self.cache and key in self._memo:

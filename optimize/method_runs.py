@@ -23,7 +23,7 @@ from mechopt.optimize.sparse.pipeline import run_pipeline
 from mechopt.optimize.sparse.sampler import Sampler
 from mechopt.optimize.sparse.space import ModelSpace
 
-__all__ = ["MethodCall", "run_auto", "run_baseline", "run_sparse", "run_sparse_global"]
+__all__ = ["MethodCall", "best_simulated", "run_auto", "run_baseline", "run_sparse", "run_sparse_global"]
 
 
 @dataclass(frozen=True)
@@ -84,8 +84,9 @@ def run_sparse(call: MethodCall) -> OptimizeResult:
         if isinstance(exc, InputError | BrokenSimulatorError) or not sampler.failures:
             raise
         return _handed_to_auto(call, f"the line model could not be built ({exc})")
-    success = bool(np.isfinite(pipeline.fun) and space.feasible(pipeline.x)[0])
-    return OptimizeResult(x=pipeline.x, fun=pipeline.fun, nfev=len(sampler.designs), success=success,
+    x, fun = best_simulated(problem, sampler, pipeline.x, pipeline.fun)
+    success = bool(np.isfinite(fun) and space.feasible(x)[0])
+    return OptimizeResult(x=x, fun=fun, nfev=len(sampler.designs), success=success,
                           message=pipeline.message, method=call.name, model=pipeline.stages[0].model,
                           stages=pipeline.stages, pipeline=pipeline, validation=None, options=opts,
                           trust=study_trust(pipeline.stages[0], pipeline.best, None))
@@ -118,10 +119,26 @@ def run_sparse_global(call: MethodCall) -> OptimizeResult:
         if np.isfinite(run.value) and run.value < fun:
             x, fun = np.asarray(x_ls, dtype=float), float(run.value)
         message += f"; Gauss-Newton on the residuals from its best design: {fun:.6g} ({run.message})"
+    x, fun = best_simulated(problem, sampler, x, fun)
     success = bool(np.all(np.isfinite(x)) and problem.feasible(x)[0])
     return OptimizeResult(x=x, fun=fun, nfev=len(sampler.designs), success=success, message=message,
                           method=call.name, model=None, models=res.models, stages=[], validation=None,
                           trust=trust)
+
+
+def best_simulated(problem: DesignProblem, sampler: Sampler, x: np.ndarray, fun: float) -> tuple[np.ndarray, float]:
+    """With discrete variables, the best feasible design the run simulated (every one is allowed: the sampler snaps
+    them) and its value, instead of a method's own answer, which may be a proposal that was rounded; ``(x, fun)``
+    unchanged when every variable is continuous."""
+    if not sampler.discrete:
+        return x, fun
+    done = [(v, d) for d, v in sampler.history.values() if np.isfinite(v)]
+    X = np.array([d for _, d in done]).reshape(-1, problem.dim)
+    ok = problem.feasible(X) if X.shape[0] else np.zeros(0, dtype=bool)
+    if not ok.any():
+        return problem.snap(x) if np.all(np.isfinite(x)) else x, fun
+    i = int(np.argmin(np.where(ok, [v for v, _ in done], np.inf)))
+    return X[i].copy(), float(done[i][0])
 
 
 def _handed_to_auto(call: MethodCall, why: str) -> OptimizeResult:
@@ -144,6 +161,7 @@ def run_auto(call: MethodCall, budget: int | None = None) -> OptimizeResult:
     """Gaussian-process steps on a plan chosen by dimension and budget (:mod:`mechopt.optimize.auto`), from
     ``call.initial`` when given; ``budget`` overrides the call's (what a handed-over run has left)."""
     from mechopt.optimize.auto import auto_search
+    from mechopt.optimize.auto.design_grid import DesignGrid
 
     problem, sampler = call.problem, call.sampler
 
@@ -156,9 +174,10 @@ def run_auto(call: MethodCall, budget: int | None = None) -> OptimizeResult:
     res = auto_search(evaluate, problem.bounds, call.budget if budget is None else budget, call.seed,
                       feasible=problem.feasible, batch=sampler.batch_size, margins=call.margins(),
                       residuals=residuals if problem.residuals else None, fd_step=problem.fd_step,
-                      initial=call.initial)
-    success = bool(np.all(np.isfinite(res.x)) and problem.feasible(res.x)[0])
-    return OptimizeResult(x=res.x, fun=res.fun, nfev=len(sampler.designs), success=success, message=res.message,
+                      initial=call.initial, grid=DesignGrid.of(problem))
+    x = problem.snap(res.x) if np.all(np.isfinite(res.x)) else res.x  # exactly the allowed design simulated
+    success = bool(np.all(np.isfinite(x)) and problem.feasible(x)[0])
+    return OptimizeResult(x=x, fun=res.fun, nfev=len(sampler.designs), success=success, message=res.message,
                           method=call.name, plan=res.plan.name, model=None, stages=[], validation=None)
 
 
@@ -178,12 +197,14 @@ def run_baseline(call: MethodCall, fn: Callable[..., Any]) -> OptimizeResult:
 
     def margins(X: np.ndarray) -> np.ndarray:
         X = np.asarray(X, dtype=float)
-        M = problem.constraint_margins(np.atleast_2d(X))
+        # The margins of the design that would be simulated: a method's feasibility test agrees with the door.
+        M = problem.constraint_margins(sampler.allowed(X))
         return M[0] if X.ndim == 1 else M
 
     progress, sampler.progress = sampler.progress, False
     counted = CountedProblem(objective, problem.bounds, call.budget, margins if problem.constraints else None,
-                             failure_errors=(InfeasibleDesignError,), vectorized_constraints=True)
+                             failure_errors=(InfeasibleDesignError,), vectorized_constraints=True,
+                             snap=(lambda x: sampler.allowed(x)[0]) if sampler.discrete else None)
     counted.variables = problem.variables  # the peers declare discrete variables in their libraries' own terms
     try:
         res = fn(counted, call.seed, **call.options)

@@ -16,6 +16,7 @@ from scipy.optimize import minimize
 from scipy.special import ndtr
 from scipy.stats import qmc
 
+from mechopt.optimize.auto.design_grid import DesignGrid
 from mechopt.optimize.auto.gp import GaussianProcess
 
 __all__ = ["log_expected_improvement", "propose_batch", "thompson_batch"]
@@ -82,9 +83,11 @@ def _with_gradient(score: Callable[[np.ndarray], np.ndarray], lo: np.ndarray,
 
 def _maximise(score: Callable[[np.ndarray], np.ndarray], lo: np.ndarray, hi: np.ndarray, C: np.ndarray,
               allowed: Callable[[np.ndarray], np.ndarray], polish: int,
-              margins: Callable[[np.ndarray], np.ndarray] | None = None) -> np.ndarray | None:
+              margins: Callable[[np.ndarray], np.ndarray] | None = None,
+              grid: DesignGrid | None = None) -> np.ndarray | None:
     """The best allowed candidate, polished from the ``polish`` best ones (kept when allowed): by L-BFGS-B, or with
-    declared constraints by SLSQP on their margins.
+    declared constraints by SLSQP on their margins.  With a ``grid`` the candidates are allowed designs and the
+    polish moves only the continuous variables (none when every variable is discrete).
 
     The optimum of a constrained design problem usually lies on an active constraint, and so does the largest
     expected improvement near it; a polish that only rejects infeasible points stays strictly inside, where the
@@ -96,6 +99,8 @@ def _maximise(score: Callable[[np.ndarray], np.ndarray], lo: np.ndarray, hi: np.
     s = score(C)
     order = np.argsort(-s)
     best_x, best_s = C[order[0]], s[order[0]]
+    if grid is not None and grid.all_discrete:
+        return np.asarray(best_x, dtype=float)
     fun, bounds = _with_gradient(score, lo, hi), list(zip(lo, hi, strict=True))
     if margins is None:
         method, extra = "L-BFGS-B", {"options": {"maxiter": 30}}
@@ -104,8 +109,10 @@ def _maximise(score: Callable[[np.ndarray], np.ndarray], lo: np.ndarray, hi: np.
         method, extra = "SLSQP", {"options": {"maxiter": 50}, "constraints": [
             {"type": "ineq", "fun": lambda u: margins(u[None, :])[0] - _MARGIN_EPS}]}
     for x0 in C[order[:polish]]:
+        if grid is not None:
+            bounds = grid.polish_bounds(x0, lo, hi)
         res = minimize(fun, x0, jac=True, method=method, bounds=bounds, **extra)
-        x = np.clip(res.x, lo, hi)
+        x = np.clip(res.x, lo, hi) if grid is None else grid.snap(np.clip(res.x, lo, hi))[0]
         if np.isfinite(res.fun) and -res.fun > best_s and allowed(x[None, :])[0]:
             best_x, best_s = x, -res.fun
     return np.asarray(best_x, dtype=float)
@@ -115,7 +122,8 @@ def propose_batch(gp: GaussianProcess, best: float, lo: np.ndarray, hi: np.ndarr
                   rng: np.random.Generator, allowed: Callable[[np.ndarray], np.ndarray],
                   log_feasible: LogFeasible | None = None, n_candidates: int = 1024,
                   polish: int = 3, kappa: float | None = None,
-                  margins: Callable[[np.ndarray], np.ndarray] | None = None, sparse: bool = False) -> np.ndarray:
+                  margins: Callable[[np.ndarray], np.ndarray] | None = None, sparse: bool = False,
+                  grid: DesignGrid | None = None) -> np.ndarray:
     """``q`` designs of the box [lo, hi] (unit cube) maximising log EI + log P(success), one after the other, each
     chosen with the previous ones believed at their posterior mean (Ginsbourger et al. 2010).
 
@@ -152,6 +160,9 @@ def propose_batch(gp: GaussianProcess, best: float, lo: np.ndarray, hi: np.ndarr
     sparse : bool
         Offer perturbations of the centre in any number of its coordinates (:func:`_candidates`); the trust
         regions' choice, where Sobol points of the box are too sparse to hold such moves in many variables.
+    grid : DesignGrid, optional
+        The allowed designs when some variables are discrete: only those are candidates
+        (:meth:`DesignGrid.candidates`), and the polish moves the continuous variables only.
 
     Returns
     -------
@@ -175,7 +186,9 @@ def propose_batch(gp: GaussianProcess, best: float, lo: np.ndarray, hi: np.ndarr
                 ok &= np.max(np.abs(U - x), axis=1) > 1e-6
             return ok
 
-        x = _maximise(score, lo, hi, _candidates(lo, hi, centre, n_candidates, rng, sparse), fresh, polish, margins)
+        C = _candidates(lo, hi, centre, n_candidates, rng, sparse)
+        x = _maximise(score, lo, hi, C if grid is None else grid.candidates(C, lo, hi, centre), fresh, polish,
+                      margins, grid)
         if x is None:
             break
         chosen.append(x)
@@ -189,7 +202,8 @@ def propose_batch(gp: GaussianProcess, best: float, lo: np.ndarray, hi: np.ndarr
 
 def thompson_batch(gp: GaussianProcess, lo: np.ndarray, hi: np.ndarray, centre: np.ndarray, q: int,
                    rng: np.random.Generator, allowed: Callable[[np.ndarray], np.ndarray],
-                   log_feasible: LogFeasible | None = None, n_candidates: int = 256) -> np.ndarray:
+                   log_feasible: LogFeasible | None = None, n_candidates: int = 256,
+                   grid: DesignGrid | None = None) -> np.ndarray:
     """``q`` designs of a trust region [lo, hi]: the minimiser of each of q joint posterior draws over the same
     candidates (Thompson sampling, as in TuRBO, Eriksson et al. 2019).
 
@@ -206,6 +220,8 @@ def thompson_batch(gp: GaussianProcess, lo: np.ndarray, hi: np.ndarray, centre: 
         Log-probability that a design's simulation succeeds; candidates below 1/2 are dropped while any is above.
     n_candidates : int
         Sobol candidates of the box (the centre's perturbations, which repeat them below 20 variables, dropped).
+    grid : DesignGrid, optional
+        The allowed designs when some variables are discrete: the candidates are moved onto them.
 
     Returns
     -------
@@ -216,6 +232,10 @@ def thompson_batch(gp: GaussianProcess, lo: np.ndarray, hi: np.ndarray, centre: 
     # (``sparse``) were measured here too: independent draws then pile onto the centre's lines, and batches of 8 on
     # Hartmann-6 at 60 simulations ended at 11.6 % of the range instead of 4.8 % (median of 5 seeds).
     C = np.unique(_candidates(lo, hi, centre, n_candidates, rng), axis=0)
+    if grid is not None:
+        C = np.unique(grid.candidates(C, lo, hi, centre), axis=0)
+        if C.shape[0] > 2 * n_candidates:  # a joint draw factorises an m x m covariance: a random share of a list
+            C = C[np.sort(rng.choice(C.shape[0], 2 * n_candidates, replace=False))]
     C = C[allowed(C)]
     if log_feasible is not None and C.shape[0]:
         likely = log_feasible(C) > math.log(0.5)

@@ -12,6 +12,7 @@ from collections.abc import Callable
 import numpy as np
 from scipy.optimize import minimize
 
+from mechopt.optimize.auto.design_grid import DesignGrid
 from mechopt.optimize.auto.gp import GaussianProcess
 
 __all__ = ["nearest_feasible", "polish_on_constraints"]
@@ -19,7 +20,8 @@ __all__ = ["nearest_feasible", "polish_on_constraints"]
 
 def polish_on_constraints(gp: GaussianProcess, centre: np.ndarray, lo: np.ndarray, hi: np.ndarray,
                           margins: Callable[[np.ndarray], np.ndarray],
-                          allowed: Callable[[np.ndarray], np.ndarray]) -> np.ndarray | None:
+                          allowed: Callable[[np.ndarray], np.ndarray],
+                          grid: DesignGrid | None = None) -> np.ndarray | None:
     """The model's constrained minimiser near ``centre`` (unit cube), or None when it is not a new allowed design.
 
     Parameters
@@ -34,12 +36,20 @@ def polish_on_constraints(gp: GaussianProcess, centre: np.ndarray, lo: np.ndarra
         ``margins(U) -> (m, c)`` constraint margins (>= 0 feasible) of designs in unit-cube coordinates.
     allowed : callable
         Designs that may be simulated (declared constraints, not simulated yet).
+    grid : DesignGrid, optional
+        With discrete variables: the relaxed minimiser's neighbouring allowed designs are ranked by the model's
+        mean, and the best one that may be simulated is returned (rounding the minimiser alone would often leave
+        the constraint it lies on).
     """
     res = minimize(lambda u: float(gp.predict(u[None, :])[0][0]), centre, method="SLSQP",
                    bounds=list(zip(lo, hi, strict=True)),
                    constraints=[{"type": "ineq", "fun": lambda u: margins(u[None, :])[0]}],
                    options={"maxiter": 100, "ftol": 1e-10})
     x = np.clip(res.x, lo, hi)
+    if grid is not None:
+        N = grid.neighbourhood(x)
+        N = N[allowed(N)]
+        return N[int(np.argmin(gp.predict(N)[0]))] if N.shape[0] else None
     return x if allowed(x[None, :])[0] else None
 
 

@@ -13,29 +13,20 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy.spatial import cKDTree
 from scipy.stats import qmc
 
 from mechopt.optimize.auto.acquisition import propose_batch, thompson_batch
 from mechopt.optimize.auto.answer import lowest_mean
-from mechopt.optimize.auto.feasibility import SuccessModel
-from mechopt.optimize.auto.gp import GaussianProcess, fit_gp
+from mechopt.optimize.auto.design_grid import ENUMERATE_MAX, DesignGrid, unique_rows
+from mechopt.optimize.auto.gp import GaussianProcess
 from mechopt.optimize.auto.least_squares_plan import least_squares_plan
 from mechopt.optimize.auto.plan import GLOBAL_MAX_POINTS, Plan, choose_plan
 from mechopt.optimize.auto.polish import nearest_feasible, polish_on_constraints
-from mechopt.optimize.auto.transform import standardise
+from mechopt.optimize.auto.run_state import BatchEvaluator, Predicate, ResidualBatchEvaluator
+from mechopt.optimize.auto.run_state import SearchRun as _Run
 from mechopt.optimize.auto.trust_region import TrustRegion
-from mechopt.runs.sample_record import KEY_DECIMALS
 
 __all__ = ["AutoResult", "auto_search"]
-
-#: ``evaluate(X) -> (n,)``: objective at designs X (n, d) in the variables' units; NaN where a simulation failed.
-BatchEvaluator = Callable[[np.ndarray], np.ndarray]
-#: ``evaluate(X) -> (values (n,), residuals)``: a least-squares problem's objective and residual vectors (None where
-#: the simulation failed).
-ResidualBatchEvaluator = Callable[[np.ndarray], tuple[np.ndarray, list]]
-#: ``feasible(X) -> bool (n,)``: designs satisfying the declared (cheap) constraints.
-Predicate = Callable[[np.ndarray], np.ndarray]
 
 #: Designs nearest the trust region's centre that its local GP is fitted to (bounds the cubic cost of a fit).
 LOCAL_POINTS = 150
@@ -78,157 +69,6 @@ class AutoResult:
     values: np.ndarray = field(repr=False)
 
 
-class _Run:
-    """The designs simulated so far (unit cube), the door to the simulator and the model fits."""
-
-    def __init__(self, evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, feasible: Predicate | None,
-                 rng: np.random.Generator, margins: Callable[[np.ndarray], np.ndarray] | None = None,
-                 residuals: ResidualBatchEvaluator | None = None) -> None:
-        self.evaluate, self.budget, self.feasible, self.rng = evaluate, budget, feasible, rng
-        self.margins = margins
-        #: A least-squares problem's evaluator, and the residual vector of every design simulated (None: failed).
-        self.residual_evaluate = residuals
-        self.R: list = []
-        self._index: dict[tuple, int] = {}
-        self.lo, self.width = bounds[:, 0], bounds[:, 1] - bounds[:, 0]
-        self.U = np.zeros((0, bounds.shape[0]))
-        self.values = np.zeros(0)
-        self.theta: np.ndarray | None = None
-        self._tree: cKDTree | None = None
-        #: Local models (the trust regions beyond the global model's size): the length-scale prior of
-        #: :mod:`~mechopt.optimize.auto.gp` and the compressed upper tail of :mod:`~mechopt.optimize.auto.transform`;
-        #: a global model has neither.
-        self.prior = False
-        self.n_full_fit = 0
-
-    @property
-    def unit_margins(self) -> Callable[[np.ndarray], np.ndarray] | None:
-        """``margins(U) -> (m, c)`` of the declared constraints at designs U of the unit cube; None without any."""
-        if self.margins is None:
-            return None
-        return lambda U: self.margins(self.to_x(U))
-
-    @property
-    def remaining(self) -> int:
-        return self.budget - self.values.size
-
-    @property
-    def ok(self) -> np.ndarray:
-        return np.isfinite(self.values)
-
-    def to_x(self, U: np.ndarray) -> np.ndarray:
-        return self.lo + np.clip(U, 0.0, 1.0) * self.width
-
-    def allowed(self, U: np.ndarray) -> np.ndarray:
-        """Designs not simulated yet that satisfy the declared constraints."""
-        U = np.atleast_2d(U)
-        fresh = np.ones(U.shape[0], dtype=bool)
-        if self.U.shape[0]:
-            if self._tree is None or self._tree.n != self.U.shape[0]:
-                self._tree = cKDTree(self.U)
-            fresh = self._tree.query(U, p=np.inf, distance_upper_bound=1e-6)[0] > 1e-6
-        if self.feasible is not None and fresh.any():
-            fresh[fresh] = self.feasible(self.to_x(U[fresh]))
-        return fresh
-
-    def simulate(self, U: np.ndarray) -> None:
-        U = np.atleast_2d(U)[: self.remaining]
-        if U.shape[0]:
-            if self.residual_evaluate is None:
-                values = np.asarray(self.evaluate(self.to_x(U)), dtype=float).reshape(-1)
-            else:
-                values, R = self.residual_evaluate(self.to_x(U))
-                values = np.asarray(values, dtype=float).reshape(-1)
-                self.R.extend(None if r is None else np.asarray(r, dtype=float) for r in R)
-            self.U, self.values = np.vstack([self.U, U]), np.concatenate([self.values, values])
-
-    def declared(self, U: np.ndarray) -> np.ndarray:
-        """Designs inside the unit cube that satisfy the declared constraints (simulated before or not)."""
-        U = np.atleast_2d(U)
-        ok = np.all((U >= 0.0) & (U <= 1.0), axis=1)
-        if self.feasible is not None and ok.any():
-            ok[ok] = self.feasible(self.to_x(U[ok]))
-        return ok
-
-    def residuals_at(self, U: np.ndarray) -> tuple[np.ndarray, list]:
-        """Objective and residuals at designs U (unit cube), simulating those not simulated yet; only the leading
-        rows the budget allows are returned."""
-        U = np.atleast_2d(U)
-        index = self._find(U)
-        # One of each design the sample store cannot tell apart (its key: KEY_DECIMALS decimals in the variables'
-        # units); the designs themselves are simulated as given, so that a design on a constraint stays on it.
-        new = {self._key(u): u for u in U[index < 0]}
-        self.simulate(np.array(list(new.values())).reshape(-1, U.shape[1]))
-        index = self._find(U)
-        n = int(np.argmax(index < 0)) if (index < 0).any() else U.shape[0]
-        return self.values[index[:n]], [self.R[i] for i in index[:n]]
-
-    def _find(self, U: np.ndarray) -> np.ndarray:
-        """Index of each design of U among those simulated, to the store's resolution (-1: not simulated)."""
-        if len(self._index) < self.U.shape[0]:
-            for i in range(len(self._index), self.U.shape[0]):
-                self._index.setdefault(self._key(self.U[i]), i)
-        return np.array([self._index.get(self._key(u), -1) for u in U], dtype=int)
-
-    def _key(self, u: np.ndarray) -> tuple:
-        return tuple(np.round(self.lo + u * self.width, KEY_DECIMALS).tolist())
-
-    def fill(self, U: np.ndarray, k: int) -> np.ndarray:
-        """``U`` topped up to ``k`` designs with allowed random ones (a proposal found too few in its box)."""
-        tries = 0
-        while U.shape[0] < k and tries < 50:
-            C = self.rng.random((64, U.shape[1]))
-            C = C[self.allowed(C)]
-            U, tries = np.vstack([U, C[: k - U.shape[0]]]), tries + 1
-        return U
-
-    def best_index(self) -> int:
-        return int(np.nanargmin(np.where(self.ok, self.values, np.inf)))
-
-    def fit(self, idx: np.ndarray | None = None) -> tuple[GaussianProcess, float]:
-        """GP of the standardised values (of ``idx``, default all) and the incumbent's target.
-
-        The hyperparameters are fitted to the designs that succeeded; a failed design then enters at the model's
-        prediction plus its variance there (Forrester, Sóbester & Keane 2006, penalised imputation).  Inside a
-        failing region no success is near, the variance is large, and the model expects nothing good next to it;
-        a sporadic failure among successes (a solver that did not converge at one design) is imputed at about what
-        its neighbours say, and leaves the landscape as it is.  The success model scales the expected improvement
-        besides.  Before, a failure entered at the worst value that succeeded: a spike beside the optimum that the
-        fit followed with short length-scales (Hartmann-3 at 30 simulations with 15 % of the designs failing at
-        random, 10 seeds: median gap 1.84 % of the range, 0.0087 % now; ``tests/optimize/test_failed_simulations.py``).
-        Inside a failing region the worst value was the stronger deterrent: failing Hartmann-3 at 100 spends 26-38
-        simulations on failures instead of 13-23, for the same answer.
-        """
-        idx = np.arange(self.values.size) if idx is None else idx
-        values = self.values[idx]
-        # An objective of +inf (a design the user's objective rejects) fails as NaN does.
-        ok = np.isfinite(values)
-        if ok.sum() < 2:
-            # Too few successes to fit to: the failures at the worst value that succeeded (here, else anywhere; or 0).
-            finite = values[ok] if ok.any() else self.values[self.ok]
-            values, ok = np.where(ok, values, float(finite.max()) if finite.size else 0.0), np.ones_like(ok)
-        good = idx[ok]
-        y = standardise(values[ok], compress_tail=self.prior)
-        full = self.theta is None or good.size >= 1.25 * self.n_full_fit
-        if full:
-            self.n_full_fit = good.size
-        # The global plan (no length-scale prior) starts from a few designs whose evidence may see white noise.
-        gp = fit_gp(self.U[good], y, self.rng, warm=self.theta, starts=3 if full else 1, maxiter=100 if full else 30,
-                    prior=self.prior, spacing_floor=not self.prior)
-        self.theta = gp.theta
-        if not ok.all():
-            failed = self.U[idx[~ok]]
-            mean, sd = gp.predict(failed)
-            gp = GaussianProcess(np.vstack([gp.X, failed]), np.concatenate([gp.y, mean + sd * sd]), gp.theta,
-                                 gp.trend.quadratic)
-        return gp, float(y.min())
-
-    def success_model(self, gp: GaussianProcess) -> Callable[[np.ndarray], np.ndarray] | None:
-        if self.ok.all():
-            return None
-        return SuccessModel(self.U, self.ok, gp.theta[: self.U.shape[1]]).log_probability
-
-
 def _initial_design(run: _Run, n: int) -> np.ndarray:
     """The first ``n`` allowed points of a scrambled Sobol sequence (rejection of the declared constraints)."""
     d = run.U.shape[1]
@@ -237,8 +77,10 @@ def _initial_design(run: _Run, n: int) -> np.ndarray:
     sobol = qmc.Sobol(d, seed=run.rng)
     chosen = np.zeros((0, d))
     for _ in range(20):
-        C = sobol.random(max(8, 2 ** int(np.ceil(np.log2(4 * n)))))
+        C = run.snap(sobol.random(max(8, 2 ** int(np.ceil(np.log2(4 * n))))))
         chosen = np.vstack([chosen, C[run.allowed(C)]])
+        if run.grid is not None:  # Sobol points that round to one allowed design are one design
+            chosen = unique_rows(chosen)
         if chosen.shape[0] >= n:
             break
     return run.fill(chosen[:n], n)
@@ -248,7 +90,7 @@ def _global_plan(run: _Run, plan: Plan) -> None:
     d = run.U.shape[1]
     ones, zeros = np.ones(d), np.zeros(d)
     probed = False
-    while run.remaining > 0:
+    while run.remaining > 0 and not _exhausted(run):
         if run.values.size >= GLOBAL_MAX_POINTS and run.remaining > plan.n_polish:
             # The global GP's fit grows as n³: a large budget goes on with local models (plan.GLOBAL_MAX_POINTS).
             run.prior, run.theta = True, None
@@ -259,10 +101,10 @@ def _global_plan(run: _Run, plan: Plan) -> None:
         centre = run.U[run.best_index()]
         lo, hi, kappa, first = zeros, ones, None, np.zeros((0, d))
         if run.remaining <= plan.n_polish:
-            lo, hi = TrustRegion(d, length=POLISH_LENGTH).box(centre, gp.theta[:d])
+            lo, hi = TrustRegion(d, length=POLISH_LENGTH, floor=_floor(run)).box(centre, gp.theta[:d])
             kappa = POLISH_KAPPA
             if run.margins is not None:
-                x = polish_on_constraints(gp, centre, lo, hi, run.unit_margins, run.allowed)
+                x = polish_on_constraints(gp, centre, lo, hi, run.unit_margins, run.allowed, run.grid)
                 first = first if x is None else x[None, :]
             if not probed and first.shape[0] < k:
                 probed = True
@@ -271,9 +113,12 @@ def _global_plan(run: _Run, plan: Plan) -> None:
         if first.shape[0] < k:
             U = propose_batch(gp, best, lo, hi, centre, k - first.shape[0], run.rng,
                               lambda C, taken=first: run.allowed(C) & _apart(C, taken), run.success_model(gp),
-                              kappa=kappa, margins=run.unit_margins)
+                              kappa=kappa, margins=run.unit_margins, grid=run.grid)
             first = np.vstack([first, U])
+        n0 = run.values.size
         run.simulate(run.fill(first, k))
+        if run.grid is not None and run.values.size == n0:
+            return  # no allowed design is left that was not simulated
 
 
 def _bound_probes(run: _Run, gp: GaussianProcess, centre: np.ndarray, most: int) -> np.ndarray:
@@ -298,7 +143,7 @@ def _bound_probes(run: _Run, gp: GaussianProcess, centre: np.ndarray, most: int)
             u = nearest_feasible(u, j, run.unit_margins, active, centre)
         if u is not None:
             probes.append(u)
-    P = np.array(probes).reshape(-1, centre.size)
+    P = run.snap(np.array(probes).reshape(-1, centre.size))
     P = P[run.allowed(P)] if P.shape[0] else P
     # The model's best guess first: off a vertex, most bounds lead uphill, and the budget allows few probes.
     return P[np.argsort(gp.predict(P)[0])][:most] if P.shape[0] > most else P
@@ -312,6 +157,18 @@ def _active_constraints(run: _Run, centre: np.ndarray) -> np.ndarray | None:
     M = run.unit_margins(np.vstack([run.U, centre]))
     spread = np.ptp(np.where(np.isfinite(M), M, np.nan), axis=0)
     return np.flatnonzero(M[-1] <= 0.01 * np.nan_to_num(spread))
+
+
+def _floor(run: _Run) -> np.ndarray | None:
+    """Least half-edge of a box on each variable (unit cube): one allowed value on each discrete one."""
+    return None if run.grid is None else run.grid.step
+
+
+def _exhausted(run: _Run) -> bool:
+    """Whether a finite space has no allowed design left that was not simulated (the search has nothing to do)."""
+    if run.grid is None or run.grid.count is None or run.grid.count > ENUMERATE_MAX:
+        return False
+    return not run.allowed(run.grid.enumerate()).any()
 
 
 def _apart(U: np.ndarray, chosen: np.ndarray) -> np.ndarray:
@@ -333,15 +190,15 @@ def _restart_centre(run: _Run) -> np.ndarray:
     gp, best = run.fit(_local_indices(run, run.U[run.best_index()]) if run.ok.sum() > 2 * LOCAL_POINTS else None)
     run.theta = saved
     U = propose_batch(gp, best, np.zeros(d), np.ones(d), run.U[run.best_index()], 1, run.rng, run.allowed,
-                      run.success_model(gp), margins=run.unit_margins, sparse=True)
+                      run.success_model(gp), margins=run.unit_margins, sparse=True, grid=run.grid)
     return run.fill(U, 1)
 
 
 def _trust_region_plan(run: _Run, plan: Plan) -> None:
     d = run.U.shape[1]
-    tr = TrustRegion(d, batch=plan.batch)
+    tr = TrustRegion(d, batch=plan.batch, floor=_floor(run))
     members = list(range(run.values.size))  # designs of the current restart: its centre is their best
-    while run.remaining > 0:
+    while run.remaining > 0 and not _exhausted(run):
         k = min(plan.batch, run.remaining)
         vals = np.where(run.ok[members], run.values[members], np.inf)
         centre_i = members[int(np.argmin(vals))]
@@ -352,15 +209,19 @@ def _trust_region_plan(run: _Run, plan: Plan) -> None:
             # The last steps refine the best design found by any restart, on the model's mean.
             centre_i = run.best_index()
             gp, best = run.fit(_local_indices(run, run.U[centre_i]))
-            lo, hi = TrustRegion(d, length=min(tr.length, POLISH_LENGTH)).box(run.U[centre_i], gp.theta[:d])
+            lo, hi = TrustRegion(d, length=min(tr.length, POLISH_LENGTH), floor=tr.floor).box(run.U[centre_i],
+                                                                                                 gp.theta[:d])
             kappa = 0.0
         if k > 1 and kappa is None:
-            U = thompson_batch(gp, lo, hi, run.U[centre_i], k, run.rng, run.allowed, run.success_model(gp))
+            U = thompson_batch(gp, lo, hi, run.U[centre_i], k, run.rng, run.allowed, run.success_model(gp),
+                               grid=run.grid)
         else:
             U = propose_batch(gp, best, lo, hi, run.U[centre_i], k, run.rng, run.allowed, run.success_model(gp),
-                              kappa=kappa, margins=run.unit_margins, sparse=True)
+                              kappa=kappa, margins=run.unit_margins, sparse=True, grid=run.grid)
         before, n0 = vals.min(), run.values.size
         run.simulate(run.fill(U, k))
+        if run.grid is not None and run.values.size == n0:
+            return  # no allowed design is left that was not simulated
         members += list(range(n0, run.values.size))
         new = run.values[n0:]
         new = new[np.isfinite(new)]
@@ -404,7 +265,7 @@ def auto_search(evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, seed:
                 feasible: Predicate | None = None, batch: int = 1,
                 margins: Callable[[np.ndarray], np.ndarray] | None = None,
                 residuals: ResidualBatchEvaluator | None = None, fd_step: float = 1e-5,
-                initial: np.ndarray | None = None) -> AutoResult:
+                initial: np.ndarray | None = None, grid: DesignGrid | None = None) -> AutoResult:
     """Minimise a simulator within ``budget`` simulations on the plan of :func:`choose_plan`.
 
     Parameters
@@ -432,6 +293,10 @@ def auto_search(evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, seed:
     initial : (m, d) ndarray, optional
         Designs simulated before (by another method, found again in the sample store): they join the model on top
         of ``budget`` and stand in for as many of the Sobol designs.
+    grid : DesignGrid, optional
+        The allowed designs when some variables are discrete (:mod:`~mechopt.optimize.auto.design_grid`): only
+        those are proposed, each at most once; a least-squares problem then takes the global plan (a
+        Gauss-Newton step would leave the grid).
 
     Returns
     -------
@@ -439,8 +304,8 @@ def auto_search(evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, seed:
     """
     bounds = np.asarray(bounds, dtype=float)
     d = bounds.shape[0]
-    plan = choose_plan(d, int(budget), int(batch), least_squares=residuals is not None)
-    run = _Run(evaluate, bounds, int(budget), feasible, np.random.default_rng(seed), margins, residuals)
+    plan = choose_plan(d, int(budget), int(batch), least_squares=residuals is not None and grid is None)
+    run = _Run(evaluate, bounds, int(budget), feasible, np.random.default_rng(seed), margins, residuals, grid)
     with _limited_threads():
         n_init, n_x0 = plan.n_init, 0
         if initial is not None and len(initial):

@@ -29,6 +29,9 @@ class TrustRegion:
         Designs simulated per step (the failure tolerance is counted in steps).
     length : float
         Edge of the box (unit cube units, before stretching), 0.8 at start.
+    floor : (d,) ndarray, optional
+        Least half-edge on each variable (unit cube): one allowed value on a discrete variable, so that a box
+        never shrinks to hold none but the centre's.
     """
 
     dim: int
@@ -39,6 +42,7 @@ class TrustRegion:
     successes: int = 0
     failures: int = 0
     success_tol: int = 3
+    floor: np.ndarray | None = None
 
     @property
     def failure_tol(self) -> int:
@@ -55,6 +59,8 @@ class TrustRegion:
         relative to their geometric mean (the box's volume is length^d)."""
         ell = np.exp(log_ell - np.mean(log_ell))
         half = 0.5 * self.length * np.clip(ell, 0.05, 20.0)
+        if self.floor is not None:
+            half = np.maximum(half, self.floor)
         return np.clip(centre - half, 0.0, 1.0), np.clip(centre + half, 0.0, 1.0)
 
     def update(self, improved: bool) -> None:

@@ -1,4 +1,9 @@
-"""The pipeline's door to the simulator: designs in, objective values out, through the resumable store."""
+"""The methods' door to the simulator: designs in, objective values out, through the resumable store.
+
+Every design is moved to its allowed design first (:meth:`~mechopt.optimize.allowed_designs.AllowedDesigns.snap`:
+the grids, integers and catalogues of discrete variables), so the store keys, simulates and returns allowed designs
+only, and two proposals that round alike are one simulation.
+"""
 
 from __future__ import annotations
 
@@ -39,6 +44,8 @@ class Sampler:
         self.progress = progress
         self.retry_failed = retry_failed
         self.fingerprint = problem.fingerprint()
+        #: Whether some variable is discrete (designs are snapped to the allowed ones).
+        self.discrete = bool(problem.discrete.any())
         if retry_failed:
             # Once per run: a design that fails again and is asked for again later is not retried twice.
             store.forget_failed(self.fingerprint)
@@ -76,9 +83,14 @@ class Sampler:
         """What ran the simulations (processes, in-process, a Dask scheduler)."""
         return getattr(self.executor, "description", "") or "in-process"
 
-    def records(self, designs: np.ndarray, desc: str) -> list[SampleRecord]:
-        """The store's records of designs (n, d), simulating those it lacks."""
+    def allowed(self, designs: np.ndarray) -> np.ndarray:
+        """Designs (n, d) moved to their allowed designs (unchanged when every variable is continuous)."""
         designs = np.atleast_2d(np.asarray(designs, dtype=float))
+        return self.problem.snap(designs) if self.discrete else designs
+
+    def records(self, designs: np.ndarray, desc: str) -> list[SampleRecord]:
+        """The store's records of the allowed designs of designs (n, d), simulating those it lacks."""
+        designs = self.allowed(designs)
         asked = [tuple(map(float, d)) for d in designs]
         keys = [design_key(d) for d in asked]
         first_time = len(set(keys) - self.designs)
@@ -111,12 +123,13 @@ class Sampler:
             watcher.record(record, cached)
 
     def __call__(self, designs: np.ndarray, desc: str) -> np.ndarray:
-        """The objective at designs (n, d); NaN where the simulation did not succeed."""
+        """The objective at the allowed designs of designs (n, d); NaN where the simulation did not succeed."""
+        designs = self.allowed(designs)
         records = self.records(designs, desc)
         # The first objective, as minimised (a maximised output negated); NaN where the simulation did not succeed.
         spec = self.problem.objective_spec
         values = np.array([spec.senses[0] * r.value(spec.names[0]) for r in records], dtype=float)
-        for d, v in zip(np.atleast_2d(np.asarray(designs, dtype=float)), values, strict=True):
+        for d, v in zip(designs, values, strict=True):
             design = tuple(map(float, d))
             self.history[design_key(design)] = (design, float(v))
         return values

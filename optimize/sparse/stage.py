@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mechopt.errors import MechoptError
+from mechopt.optimize.sparse.allowed_candidate import best_allowed_near
 from mechopt.optimize.sparse.feasible_point import pull_into_feasible
 from mechopt.optimize.sparse.model import ObjectiveModel
 from mechopt.optimize.sparse.options import SparseOptions
@@ -211,6 +212,7 @@ def build_stage(name: str, space: ModelSpace, options: SparseOptions, sampler: S
                            f"and the others cannot make a model ({exc}); see the failures in the store, or give "
                            "more lines (--lines-fit, options={'n_lines': N})") from None
     candidate = pull_into_feasible(space, space.from_u(found.x), np.vstack(line_designs))
+    candidate = best_allowed_near(space.problem, model.predict, candidate)
     predicted = float(model.predict(candidate)[0])
     simulated = float(sampler(candidate[None, :], desc=f"{name}: confirm")[0])
     return Stage(name=name, plan=plan, coverage=float(cov), model=model, line_designs=line_designs,

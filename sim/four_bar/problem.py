@@ -45,6 +45,9 @@ class FourBarProblem(DesignProblem):
         Pivot C, inertias, rocker load, motion law, branch, toggle margin.
     box : (3, 2) array_like
         Bounds of |OA|, |AB|, |BC| (mm).
+    kinds : tuple of 3 dicts, optional
+        The kind of each length when it is discrete, as keyword arguments of
+        :class:`~mechopt.optimize.variable.Variable` (``{"step": 0.1}`` for a drawing at 0.1 mm); ``{}`` continuous.
     engine : str
         ``"pymunk"``, ``"analytic"`` or ``"exudyn"``.
     name : str
@@ -66,6 +69,7 @@ class FourBarProblem(DesignProblem):
     n_check_search: int = 61
     #: How the mechanism was recovered from data, when it was (for reports; its numbers are in the mechanism).
     reconstruction: Any = None
+    kinds: tuple | None = None
 
     constraints = MARGIN_NAMES
     outputs = ("t_rms", "t_max", "toggle_margin_deg")
@@ -90,7 +94,8 @@ class FourBarProblem(DesignProblem):
 
     @property
     def variables(self) -> tuple[Variable, ...]:  # type: ignore[override]
-        return tuple(Variable(n, lo, hi, "mm", _LABELS[n]) for n, (lo, hi) in zip(_LABELS, self.box, strict=True))
+        return tuple(Variable(n, lo, hi, "mm", _LABELS[n], **kind)
+                     for n, (lo, hi), kind in zip(_LABELS, self.box, self.kinds or ({}, {}, {}), strict=True))
 
     def evaluate(self, x: np.ndarray) -> dict[str, float]:
         """T_RMS and T_max (N·m) and the toggle margin (deg: how far the crank-coupler angle at A stays from the

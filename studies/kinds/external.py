@@ -7,6 +7,8 @@
     [variables]
     width = { lower = 10.0, upper = 40.0, unit = "mm", label = "w" }
     angle = [0.0, 1.5]                    # bounds only: no unit
+    teeth = { bounds = [12, 40], integer = true }
+    wire = { values = [0.5, 0.63, 0.8, 1.0], unit = "mm" }   # a catalogue (also: step = 0.1 for a drawing grid)
 
     [simulator]
     command = ["{python}", "my_sim.py"]
@@ -27,11 +29,9 @@ import numpy as np
 from mechopt.errors import StudyError
 from mechopt.optimize.problem import DesignProblem, Variable
 from mechopt.studies.study_file import StudyFile
+from mechopt.studies.variable_entry import study_variable
 
 __all__ = ["VariablesProblem", "problem_from_study"]
-
-_VARIABLE_KEYS = ("lower", "upper", "unit", "label")
-
 
 class VariablesProblem(DesignProblem):
     """Design variables and nothing else: the ``[simulator]`` of the study supplies the evaluator.
@@ -53,29 +53,6 @@ class VariablesProblem(DesignProblem):
         raise StudyError(f"study {self.name!r} of kind \"external\" has no evaluator of its own: add a [simulator]")
 
 
-def _variable(study: StudyFile, name: str, value: Any) -> Variable:
-    where = f"variables.{name}"
-    if isinstance(value, list):
-        lower, upper = study.numbers({name: value}, name, "variables", length=2)
-        unit, label = "", ""
-    elif isinstance(value, dict):
-        unknown = sorted(set(value) - set(_VARIABLE_KEYS))
-        if unknown:
-            raise StudyError(f"{study.where}: unknown key {where}.{unknown[0]}; expected one of {list(_VARIABLE_KEYS)}")
-        lower = study.number(value, "lower", where)
-        upper = study.number(value, "upper", where)
-        unit = study.string(value, "unit", where, "")
-        label = study.string(value, "label", where, "")
-    else:
-        raise StudyError(f"{study.where}: key {where} = {value!r} must be [lower, upper] or "
-                         "{ lower = .., upper = .., unit = \"mm\" }")
-    if not name.isidentifier():
-        raise StudyError(f"{study.where}: variable name {name!r} must be an identifier such as 'width'")
-    if not lower < upper:
-        raise StudyError(f"{study.where}: key {where}: bounds [{lower}, {upper}] must satisfy lower < upper")
-    return Variable(name, lower, upper, unit, label)
-
-
 def problem_from_study(study: StudyFile, options: dict[str, Any]) -> VariablesProblem:
     """The variables of a study of kind ``"external"`` (the engine then applies its ``[simulator]``).
 
@@ -95,5 +72,5 @@ def problem_from_study(study: StudyFile, options: dict[str, Any]) -> VariablesPr
     table = study.table("variables")
     if not table:
         raise StudyError(f"{study.where}: section [variables] declares no variable")
-    variables = tuple(_variable(study, name, value) for name, value in table.items())
+    variables = tuple(study_variable(study, name, value) for name, value in table.items())
     return VariablesProblem(str(study.config.get("name", study.path.parent.name)), variables)

@@ -22,6 +22,7 @@ from mechopt.sim.four_bar.problem import FourBarProblem
 from mechopt.sim.four_bar.reconstruction import read_motor_table, reconstruct
 from mechopt.sim.four_bar.simulate import ENGINES
 from mechopt.studies.study_file import StudyFile
+from mechopt.studies.variable_entry import study_variable
 
 __all__ = ["problem_from_study"]
 
@@ -33,6 +34,8 @@ _LOAD_KEYS = {"rocker_Nm", "table"}
 _SAMPLING_KEYS = {"engine", "toggle_relax_deg", "box_extend"}
 _BRANCHES = {"theta1": BRANCH_SUBTRACT, "theta2": BRANCH_ADD}
 _NAMES = ("oa", "ab", "bc")
+#: Keys of a length written as a table (always in mm).
+_LENGTH_KEYS = ("bounds", "lower", "upper", "step", "integer", "values")
 
 
 def problem_from_study(study: StudyFile, options: dict[str, Any]) -> FourBarProblem:
@@ -101,24 +104,30 @@ def _problem(study: StudyFile, options: dict[str, Any]) -> FourBarProblem:
     )
     sampling = study.table("sampling", _SAMPLING_KEYS, required=False)
     engine = options.get("engine") or study.string(sampling, "engine", "sampling", "pymunk", ENGINES)
-    box = _box(study)
+    box, kinds = _box(study)
     return FourBarProblem(
         mechanism=mechanism, box=box, engine=engine, name=str(study.config.get("name", study.path.parent.name)),
         toggle_relax_deg=study.number(sampling, "toggle_relax_deg", "sampling", 5.0, minimum=0.0),
         box_extend=study.number(sampling, "box_extend", "sampling", 0.15, minimum=0.0, maximum=1.0),
-        reconstruction=reconstruction,
+        reconstruction=reconstruction, kinds=kinds if any(kinds) else None,
     )
 
 
-def _box(study: StudyFile) -> np.ndarray:
+def _box(study: StudyFile) -> tuple[np.ndarray, tuple[dict[str, Any], ...]]:
+    """The bounds of the three lengths (mm) and the kind of each (``{}``, ``{"step": 0.1}``...)."""
     variables = study.table("variables", _NAMES)
-    box = []
+    box, kinds = [], []
     for name in _NAMES:
-        lo, hi = study.numbers(variables, name, "variables", length=2)
-        if not 0 < lo < hi:
-            raise StudyError(f"{study.where}: key variables.{name} = [{lo}, {hi}] must satisfy 0 < lower < upper (mm)")
-        box.append((lo, hi))
-    return np.array(box)
+        if name not in variables:
+            raise StudyError(f"{study.where}: missing key variables.{name}")
+        v = study_variable(study, name, variables[name], "mm", keys=_LENGTH_KEYS)
+        if not 0 < v.lower < v.upper:
+            raise StudyError(f"{study.where}: key variables.{name} = [{v.lower}, {v.upper}] must satisfy 0 < lower < "
+                             "upper (mm)")
+        box.append((v.lower, v.upper))
+        kinds.append({k: getattr(v, k) for k in ("step", "values") if getattr(v, k) is not None}
+                     | ({"integer": True} if v.integer else {}))
+    return np.array(box), tuple(kinds)
 
 
 def _explicit_load(study: StudyFile) -> RockerLoad:
