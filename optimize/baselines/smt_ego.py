@@ -130,10 +130,11 @@ def minimize_smt_ego(
     -----
     On a problem with discrete variables this is SMT's mixed-integer EGO
     (:func:`~mechopt.optimize.baselines.smt_mixed_ego.minimize_smt_mixed_ego`: SMT's design space of integer and
-    ordinal variables, its default squared-exponential kernel); ``corr`` and ``krg_options`` do not apply there.
+    ordinal variables, its default squared-exponential kernel); ``corr`` does not apply there.
     """
     if has_discrete(problem):
-        return minimize_smt_mixed_ego(problem, seed, n_doe=n_doe, n_start=n_start, n_candidates=n_candidates)
+        return minimize_smt_mixed_ego(problem, seed, n_doe=n_doe, n_start=n_start, n_candidates=n_candidates,
+                                      krg_options=krg_options)
     applications = require("smt.applications", "smt_ego")
     models = require("smt.surrogate_models", "smt_ego")
     design_space = require("smt.design_space", "smt_ego")

@@ -137,7 +137,8 @@ def _mixed_constrained_ego(ego_class: type, problem: CountedProblem, rng: np.ran
 
 
 def minimize_smt_mixed_ego(problem: CountedProblem, seed: int, *, n_doe: int | None = None, n_start: int = 5,
-                           n_candidates: int = 1000, corr: str = "squar_exp") -> OptimizeResult:
+                           n_candidates: int = 1000, corr: str = "squar_exp",
+                           krg_options: dict[str, Any] | None = None) -> OptimizeResult:
     """SMT's mixed-integer EGO with EI maximised over the feasible allowed designs, ``budget`` simulations.
 
     Parameters
@@ -154,6 +155,8 @@ def minimize_smt_mixed_ego(problem: CountedProblem, seed: int, *, n_doe: int | N
         Feasible allowed designs on which the expected improvement is evaluated.
     corr : str, default "squar_exp"
         Kriging correlation kernel (SMT's default; an exponential one with a mixed design space).
+    krg_options : dict, optional
+        Further options of SMT's ``KRG`` (e.g. ``{"n_start": 2}``: fewer starts of its hyperparameter search).
 
     Returns
     -------
@@ -182,7 +185,8 @@ def minimize_smt_mixed_ego(problem: CountedProblem, seed: int, *, n_doe: int | N
         return np.array(out, dtype=float).reshape(-1, 1)
 
     space = smt_design_space(design_space, problem, seed)
-    surrogate = models.KRG(print_global=False, corr=corr, design_space=space, seed=seed)
+    surrogate = models.KRG(**{"print_global": False, "corr": corr, "design_space": space, "seed": seed,
+                              **(krg_options or {})})
     ego = _mixed_constrained_ego(applications.EGO, problem, rng, n_candidates)(
         n_iter=n_iter, criterion="EI", xdoe=to_folded(problem, X0), surrogate=surrogate, n_start=n_start, seed=seed)
     message = f"{n_iter} mixed-integer EGO iterations done"
