@@ -34,14 +34,16 @@ class AllowedDesigns:
         counts = [v.count for v in self.variables]
         return None if None in counts else math.prod(counts)
 
-    def snap(self, X: Any) -> np.ndarray:
-        """Designs (n, d) or (d,) moved to their nearest allowed design (clipped to the box; discrete variables
-        rounded to their grid, integers or catalogue).  A continuous problem's designs are only clipped."""
+    def snap(self, X: Any, clip: bool = True) -> np.ndarray:
+        """Designs (n, d) or (d,) moved to their nearest allowed design (discrete variables clipped to the box and
+        rounded to their grid, integers or catalogue; continuous ones unchanged).  ``clip=False``: a grid or the
+        integers continue beyond the bounds (:meth:`Variable.snap`), for designs a method samples outside the
+        box on purpose."""
         X = np.asarray(X, dtype=float)
         out = np.array(X, dtype=float, ndmin=2, copy=True)
         for j, v in enumerate(self.variables):
             if v.discrete:
-                out[:, j] = v.snap(out[:, j])
+                out[:, j] = v.snap(out[:, j], clip)
         return out.reshape(X.shape)
 
     def on_grid(self, X: Any) -> np.ndarray:
@@ -52,3 +54,16 @@ class AllowedDesigns:
             return np.ones(len(X), dtype=bool)
         tol = 10.0 ** -(KEY_DECIMALS - 1)
         return np.all(np.abs(self.snap(X)[:, mask] - X[:, mask]) <= tol, axis=1)
+
+    def space_text(self, budget: int | None = None) -> str:
+        """One line for a plan: the discrete variables' kinds and the number of distinct designs when finite, and
+        whether ``budget`` simulations cover them; empty when every variable is continuous."""
+        if not self.discrete.any():
+            return ""
+        kinds = ", ".join(f"{v.name} {v.describe_kind()}" for v in self.variables if v.discrete)
+        count = self.design_count
+        if count is None:
+            return f"discrete variables: {kinds}; every design simulated lies on them"
+        covered = (f"; the budget of {budget} covers them all: the method may enumerate the space"
+                   if budget is not None and budget >= count else "")
+        return f"discrete variables: {kinds}; {count:,} distinct designs{covered}"

@@ -9,6 +9,7 @@ import numpy as np
 
 from mechopt.errors import InputError
 from mechopt.optimize.methods import AUTO_METHOD, DEFAULT_METHOD, MIN_BUDGET, available_methods, get_method
+from mechopt.runs.sample_record import KEY_DECIMALS
 
 __all__ = ["AUTO_METHOD", "DEFAULT_METHOD", "MIN_BUDGET", "available_methods", "check_budget", "check_method",
            "check_seed", "check_workers", "check_x0", "handles_dim", "method_min_budget"]
@@ -62,6 +63,7 @@ def check_x0(problem: Any, x0: Any, budget: int) -> np.ndarray | None:
             v = problem.variables[int(outside[0])]
             raise InputError(f"x0 design {x.tolist()}: {v.name} = {x[outside[0]]:g} lies outside [{v.lower:g}, "
                              f"{v.upper:g}]" + (f" {v.unit}" if v.unit else ""))
+    _check_on_grid(problem, X)
     infeasible = np.flatnonzero(~problem.feasible(X))
     if infeasible.size:
         x = X[infeasible[0]]
@@ -73,6 +75,21 @@ def check_x0(problem: Any, x0: Any, budget: int) -> np.ndarray | None:
         raise InputError(f"x0 holds {X.shape[0]} designs and the budget is {budget}: the designs of x0 count in the "
                          "budget and leave the method none")
     return X
+
+
+def _check_on_grid(problem: Any, X: np.ndarray) -> None:
+    """Refuse a design of x0 whose discrete variable holds a value it does not allow: the designs a method starts
+    from are simulated as given, and a rounded one may break a constraint the user's design met (the ventilator's
+    continuous optimum rounded to 0.1 mm does)."""
+    for x in X:
+        for v, value in zip(problem.variables, x, strict=True):
+            if not v.discrete or abs(float(v.snap(value)) - value) <= 10.0 ** -(KEY_DECIMALS - 1):
+                continue
+            allowed = v.allowed()
+            i = int(np.searchsorted(allowed, value))
+            below, above = allowed[max(i - 1, 0)], allowed[min(i, allowed.size - 1)]
+            raise InputError(f"x0 design {x.tolist()}: {v.name} = {value:g} is not an allowed value "
+                             f"({v.describe_kind()}); expected an allowed value such as {below:g} or {above:g}")
 
 
 def check_method(method: Any, dim: int, name: str = "the problem", budget: int | None = None,

@@ -198,13 +198,13 @@ def run_baseline(call: MethodCall, fn: Callable[..., Any]) -> OptimizeResult:
     def margins(X: np.ndarray) -> np.ndarray:
         X = np.asarray(X, dtype=float)
         # The margins of the design that would be simulated: a method's feasibility test agrees with the door.
-        M = problem.constraint_margins(sampler.allowed(X))
+        M = problem.constraint_margins(problem.snap(np.atleast_2d(X)) if sampler.discrete else np.atleast_2d(X))
         return M[0] if X.ndim == 1 else M
 
     progress, sampler.progress = sampler.progress, False
     counted = CountedProblem(objective, problem.bounds, call.budget, margins if problem.constraints else None,
                              failure_errors=(InfeasibleDesignError,), vectorized_constraints=True,
-                             snap=(lambda x: sampler.allowed(x)[0]) if sampler.discrete else None)
+                             snap=problem.snap if sampler.discrete else None)
     counted.variables = problem.variables  # the peers declare discrete variables in their libraries' own terms
     try:
         res = fn(counted, call.seed, **call.options)

@@ -199,20 +199,26 @@ class Variable:
         step = 1.0 if self.integer else float(self.step)
         return np.round(self.lower + step * np.arange(self.count), KEY_DECIMALS)
 
-    def snap(self, v: Any) -> np.ndarray:
+    def snap(self, v: Any, clip: bool = True) -> np.ndarray:
         """The allowed value nearest to each value (clipped to the bounds first); continuous: only clipped.
 
         Parameters
         ----------
         v : array_like
             Values in ``unit``.
+        clip : bool, default True
+            False: a value beyond a bound goes to the nearest value of the grid (or the integers) continued past
+            the bound, and a continuous value stays as it is (a line model's samples beyond the box stay apart);
+            a catalogue is always clipped.
 
         Returns
         -------
         ndarray
             Same shape, every value allowed (rounded to the store's resolution, so equal designs compare equal).
         """
-        v = np.clip(np.asarray(v, dtype=float), self.lower, self.upper)
+        v = np.asarray(v, dtype=float)
+        if clip or self.values is not None:
+            v = np.clip(v, self.lower, self.upper)
         if self.values is not None:
             cat = np.asarray(self.values)
             i = np.clip(np.searchsorted(cat, v), 1, len(cat) - 1)
@@ -220,7 +226,8 @@ class Variable:
         if not self.discrete:
             return v
         step = 1.0 if self.integer else float(self.step)
-        k = np.clip(np.floor((v - self.lower) / step + 0.5), 0, self.count - 1)
+        k = np.floor((v - self.lower) / step + 0.5)
+        k = np.clip(k, 0, self.count - 1) if clip else k
         return np.round(self.lower + k * step, KEY_DECIMALS)
 
     def neighbours(self, value: float) -> np.ndarray:

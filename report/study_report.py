@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from mechopt.errors import InputError
+from mechopt.report.allowed_designs_section import allowed_designs_lines, allowed_designs_summary, variable_summary
 from mechopt.report.convergence import plot_convergence
 from mechopt.report.plots import plot_feasible_3d, plot_feasible_slices, plot_validation
 from mechopt.report.tolerance_section import tolerance_lines, tolerance_summary
@@ -96,8 +97,7 @@ def result_dict(run) -> dict[str, Any]:
     return {
         "study": study.name,
         "kind": study.kind,
-        "problem": {"name": problem.name, "variables": [{"name": v.name, "unit": v.unit, "lower": v.lower,
-                                                         "upper": v.upper} for v in problem.variables],
+        "problem": {"name": problem.name, "variables": [variable_summary(v) for v in problem.variables],
                     "objective": obj, "fit": problem.fit if res.model is None else res.model.fit,
                     "method": res.method, "fingerprint": problem.fingerprint(),
                     "settings": problem.settings()},
@@ -107,6 +107,7 @@ def result_dict(run) -> dict[str, Any]:
                                         problem.constraint_margins(np.asarray(res.x)[None, :])[0].tolist(),
                                         strict=True))},
         "designs": designs,
+        "allowed_designs": allowed_designs_summary(problem, int(run.options.budget), run.references, float(res.fun)),
         "simulations": {**run.sampling, "model_lines": res.stages[0].n_samples if res.get("stages") else 0},
         "failures": [{"design": problem.design_dict(d), "error": e} for d, e in run.failures],
         "stages": [s.summary() for s in res.get("stages") or []],
@@ -225,6 +226,7 @@ def report_markdown(r: dict[str, Any], study) -> str:
              *([f"**W{r['reference_warning'][1:]}**", ""] if r.get("reference_warning") else []),
              "## Designs", ""]
     lines += _design_table(r, problem, names, units)
+    lines += allowed_designs_lines(r)
     lines += tolerance_lines(r)
     if r["failures"]:
         lines += ["", f"## Failed simulations ({len(r['failures'])})", "", "| design | error |", "|---|---|"]

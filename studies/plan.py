@@ -106,6 +106,8 @@ class RunPlan:
     headline: str | None = None
     #: The method's own computing (s; None: not measured for it), from :mod:`mechopt.studies.method_time`.
     method_s: float | None = None
+    #: The problem's discrete variables and how many designs they allow (empty when all are continuous).
+    space: str = ""
 
     @property
     def total(self) -> int:
@@ -136,7 +138,7 @@ class RunPlan:
             share = (f"{self.validation} held-out simulations on top of it ({self.validation / self.budget:.0%})"
                      if self.validation else "no held-out validation")
             head = f"plan: budget {self.budget} simulations to optimise, {share}"
-        lines = [f"{head}; {self.workers} at a time"]
+        lines = [f"{head}; {self.workers} at a time"] + ([f"  {self.space}"] if self.space else [])
         for s in self.stages:
             count = f"{s.simulations}" if s.exact else f"up to {s.simulations}"
             held = f", {s.held} already in the store" if s.held else ""
@@ -159,6 +161,7 @@ class RunPlan:
         return {"budget": self.budget, "validation": self.validation, "workers": self.workers,
                 "seconds_per_run": self.per_run, "cost_source": self.cost_source, "total": self.total,
                 "new": self.new, "expected_s": self.seconds, "rounds": self.rounds, "method_s": self.method_s,
+                "space": self.space,
                 "stages": [{"name": s.name, "simulations": s.simulations, "held": s.held, "parallel": s.parallel,
                             "exact": s.exact, "rounds": s.rounds(self.workers)} for s in self.stages]}
 
@@ -246,7 +249,7 @@ def plan_run(study: Study, options: SparseOptions, method: str, store: SampleSto
                                 _held(store, np.vstack(list(references.values())), fingerprint, retry_failed)))
     per_run, source = seconds_per_run(study, store)
     return RunPlan(stages, budget, validation, workers, per_run, source,
-                   method_s=method_seconds(method, problem.dim, budget))
+                   method_s=method_seconds(method, problem.dim, budget), space=problem.space_text(budget))
 
 
 def _line_stage(study: Study, options: SparseOptions, store: SampleStore | None, retry_failed: bool) -> PlanStage:

@@ -25,7 +25,7 @@ def better_references(references: Mapping[str, Mapping[str, Any]], objective: st
     Parameters
     ----------
     references : mapping
-        Name -> ``{"status", "outputs", "feasible"}`` of each reference design (the entry ``"optimum"``, the
+        Name -> ``{"status", "outputs", "feasible", "allowed"}`` of each reference design (the entry ``"optimum"``, the
         answer itself, is skipped).
     objective : str
         Name of the output minimised.
@@ -39,7 +39,9 @@ def better_references(references: Mapping[str, Mapping[str, Any]], objective: st
     """
     better = []
     for name, ref in references.items():
-        if name == "optimum" or ref.get("status") != "ok" or not ref.get("feasible", True):
+        # A reference off the variables' grids (a continuous optimum) is no design the run could have returned.
+        if name == "optimum" or ref.get("status") != "ok" or not ref.get("feasible", True) \
+                or not ref.get("allowed", True):
             continue
         value = ref.get("outputs", {}).get(objective)
         if value is None or not math.isfinite(value):

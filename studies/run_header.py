@@ -32,7 +32,7 @@ def study_header(study: Study) -> list[str]:
     the simulator."""
     problem = study.problem
     variables = ", ".join(f"{v.name} in [{v.lower:g}, {v.upper:g}]{(' ' + v.unit) if v.unit else ''}"
-                          for v in problem.variables)
+                          + (f" ({v.describe_kind()})" if v.discrete else "") for v in problem.variables)
     constraints = f"; constraints {', '.join(problem.constraints)}" if problem.constraints else ""
     objective = problem.output_label(problem.objective)
     title = f"study {study.name}" + (f": {study.description}" if study.description else "")

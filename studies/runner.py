@@ -29,6 +29,7 @@ from mechopt.optimize.sparse.options import SparseOptions
 from mechopt.optimize.sparse.sampler import Sampler
 from mechopt.optimize.sparse.space import ModelSpace
 from mechopt.optimize.sparse.validate import Validation, validate
+from mechopt.report.allowed_designs_section import allowed_designs_summary
 from mechopt.runs.early_stop import DEFAULT_STOP_AFTER_FAILURES
 from mechopt.runs.executors import check_reachable, default_workers, make_executor
 from mechopt.runs.run_journal import RunJournal, describe_run
@@ -331,9 +332,10 @@ def _references(study: Study, x_opt: np.ndarray, sampler: Sampler) -> dict[str, 
     """Every reference design of the study, and the optimum, with its outputs and feasibility."""
     problem = study.problem
     refs = {**study.reference_designs(), "optimum": np.asarray(x_opt, dtype=float)}
-    records = sampler.records(np.vstack(list(refs.values())), desc="reference designs")
+    # As written in the study file: a reference off the variables' grids (a continuous optimum) is what it is.
+    records = sampler.records(np.vstack(list(refs.values())), desc="reference designs", snap=False)
     return {name: {"design": problem.design_dict(x), "status": r.status, "outputs": dict(r.outputs),
-                   "error": r.error, "feasible": bool(problem.feasible(x)[0])}
+                   "error": r.error, "feasible": bool(problem.feasible(x)[0]), "allowed": bool(problem.on_grid(x)[0])}
             for (name, x), r in zip(refs.items(), records, strict=True)}
 
 
@@ -363,9 +365,18 @@ def summary_lines(run: StudyRun) -> list[str]:
         lines.append(f"ground truth (brute force, grid {run.truth.step:g} + polish): "
                      f"{problem.describe(np.array(run.truth.x))}, {obj} {run.truth.fun:.6g}; gap "
                      f"{100 * (run.result.fun / run.truth.fun - 1):+.2f} %")
+    lines += [f"against {name} (off the variables' grids, {obj} {c['objective']:.6g}): the grid costs "
+              f"{c['cost_pct']:+.3f} %" for name, c in _grid_costs(run).items()]
     lines.append(_simulations_line(run))
     warning = reference_warning(run.references, obj, float(run.result.fun), dict(problem.output_units).get(obj, ""))
     return lines if warning is None else [*lines, warning]
+
+
+def _grid_costs(run: StudyRun) -> dict[str, dict[str, float]]:
+    """What holding the answer to the allowed designs cost against each feasible reference design off the grid."""
+    summary = allowed_designs_summary(run.study.problem, int(run.options.budget), run.references,
+                                      float(run.result.fun))
+    return {} if summary is None else summary["cost_against"]
 
 
 def _simulations_line(run: StudyRun) -> str:

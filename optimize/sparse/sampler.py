@@ -86,11 +86,13 @@ class Sampler:
     def allowed(self, designs: np.ndarray) -> np.ndarray:
         """Designs (n, d) moved to their allowed designs (unchanged when every variable is continuous)."""
         designs = np.atleast_2d(np.asarray(designs, dtype=float))
-        return self.problem.snap(designs) if self.discrete else designs
+        # Not clipped: the line model samples beyond the box on purpose, and its samples there must stay apart.
+        return self.problem.snap(designs, clip=False) if self.discrete else designs
 
-    def records(self, designs: np.ndarray, desc: str) -> list[SampleRecord]:
-        """The store's records of the allowed designs of designs (n, d), simulating those it lacks."""
-        designs = self.allowed(designs)
+    def records(self, designs: np.ndarray, desc: str, snap: bool = True) -> list[SampleRecord]:
+        """The store's records of the allowed designs of designs (n, d), simulating those it lacks; ``snap=False``
+        simulates the designs as given (a study's reference designs, e.g. a continuous optimum beside a grid's)."""
+        designs = self.allowed(designs) if snap else np.atleast_2d(np.asarray(designs, dtype=float))
         asked = [tuple(map(float, d)) for d in designs]
         keys = [design_key(d) for d in asked]
         first_time = len(set(keys) - self.designs)
