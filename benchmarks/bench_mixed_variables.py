@@ -84,9 +84,9 @@ def _cap(method: str, dim: int, cap_model: int) -> int | None:
 
 def table(rows: list[dict], methods: list[str]) -> str:
     """Markdown table: per problem and budget, each method's median gap, feasible seeds, off-grid and repeated
-    simulations, unfinished runs and median wall time."""
+    simulations, median simulations spent, unfinished runs and median wall time."""
     out = ["| problem | budget | method | median gap % | feasible seeds | median f | off-grid / repeated designs "
-           "| unfinished | median s |", "|---|---|---|---|---|---|---|---|---|"]
+           "| simulations (median) | unfinished | median s |", "|---|---|---|---|---|---|---|---|---|---|"]
     for name in MIXED_SUITE:
         for budget in sorted({r["budget"] for r in rows}):
             for method in methods:
@@ -101,8 +101,10 @@ def table(rows: list[dict], methods: list[str]) -> str:
                     med = f"— (only {len(ok)} of {len(rs)} feasible)"
                 value = f"{statistics.median(r['value'] for r in ok):.6g}" if ok else "—"
                 bad = f"{sum(r['off_grid'] for r in rs)} / {sum(r['repeats'] for r in rs)}"
+                nfev = statistics.median(r["nfev"] for r in rs)
                 out.append(f"| {name} | {budget} | {method} | {med} | {len(ok)}/{len(rs)} | {value} | {bad} | "
-                           f"{sum(not r['finished'] for r in rs)} | {statistics.median(r['wall_s'] for r in rs):.1f} |")
+                           f"{nfev:g} | {sum(not r['finished'] for r in rs)} | "
+                           f"{statistics.median(r['wall_s'] for r in rs):.1f} |")
     return "\n".join(out)
 
 
