@@ -80,6 +80,23 @@ def main() -> None:
           f"{n / np.max(times_nocheck):,.0f} | {n / np.min(times_nocheck):,.0f} | >= 50,000 |")
     print(f"| analytic batch, designs/s (with feasibility check) | {n / np.median(times_check):,.0f} | "
           f"{n / np.max(times_check):,.0f} | {n / np.min(times_check):,.0f} | >= 50,000 |")
+    rowing = _rowing_times()
+    print(f"| rowing (paper 003), ms per design (closed form) | {1e3 * np.median(rowing):.3f} | "
+          f"{1e3 * np.min(rowing):.3f} | {1e3 * np.max(rowing):.3f} | <= 0.2 |")
+
+
+def _rowing_times(repeats: int = 20, calls: int = 200) -> np.ndarray:
+    """Seconds per call of the rowing study's evaluator at the paper's optimum (closed form, no time stepping)."""
+    problem = load_study("rowing").problem
+    x = np.array([3.3, 13.5])
+    problem.evaluate(x)
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        for _ in range(calls):
+            problem.evaluate(x)
+        times.append((time.perf_counter() - t0) / calls)
+    return np.array(times)
 
 
 if __name__ == "__main__":

@@ -9,6 +9,7 @@ import numpy as np
 
 from mechopt.cli.arguments import int_list, positive_float, positive_int
 from mechopt.cli.study_arguments import load, study_name
+from mechopt.errors import InputError
 
 __all__ = ["add_parser", "run"]
 
@@ -43,6 +44,9 @@ def _studies(args: argparse.Namespace, names: list[str]) -> list:
         engine = args.engine or study.section("compare").get("engine")
         if engine:
             study = load(argparse.Namespace(study=name, engine=engine))
+        if study.problem.objective_spec.k > 1:
+            raise InputError(f"study {name!r} has {study.problem.objective_spec.k} objectives; compare scores one: "
+                             "its multi-objective peers run in `python -m benchmarks.bench_pareto`")
         studies.append(study)
     return studies
 

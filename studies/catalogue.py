@@ -102,23 +102,25 @@ def packaged_studies() -> list[str]:
 
 
 def available_studies() -> list[str]:
-    """Names of the studies shipped with mechopt (and of the multimodal test functions, for ``mechopt compare``)."""
-    from mechopt.studies.benchmark_functions import SUITE
-    from mechopt.studies.mixed_variable_functions import MIXED_SUITE
+    """Names of the studies shipped with mechopt, then of the test functions and test problems (classes, no file)."""
+    return packaged_studies() + [name for suite in _test_suites() for name in sorted(suite[1])]
 
-    return packaged_studies() + sorted(SUITE) + sorted(MIXED_SUITE)
+
+def _test_suites() -> list[tuple[str, dict[str, Any], Path]]:
+    """``(kind, {name: problem class}, module file)`` of each registry of test problems."""
+    from mechopt.studies import benchmark_functions, mixed_variable_functions, multi_objective_functions
+
+    return [("test-function", benchmark_functions.SUITE, Path(benchmark_functions.__file__)),
+            ("test-problem", multi_objective_functions.MULTI_OBJECTIVE_SUITE, Path(multi_objective_functions.__file__)),
+            ("test-function", mixed_variable_functions.MIXED_SUITE, Path(mixed_variable_functions.__file__))]
 
 
 def _suite_study(name: str) -> Study | None:
-    """A test function of the multimodal or the mixed-variable suite as a study (no file: its problem is a class)."""
-    from mechopt.studies import benchmark_functions, mixed_variable_functions
-
-    for module, suite in ((benchmark_functions, benchmark_functions.SUITE),
-                          (mixed_variable_functions, mixed_variable_functions.MIXED_SUITE)):
+    """A test function or test problem of a suite as a study (no file: its problem is a class)."""
+    for kind, suite, path in _test_suites():
         cls = suite.get(name)
         if cls is not None:
-            return Study(name=name, path=Path(module.__file__), description=cls.summary(), kind="test-function",
-                         problem=cls())
+            return Study(name=name, path=path, description=cls.summary(), kind=kind, problem=cls())
     return None
 
 

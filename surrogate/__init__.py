@@ -6,13 +6,25 @@ model.  It works on generic coordinates X in R^d (d = 3 for the four-bar; the ca
 and does not depend on the simulation code.
 """
 
-from mechopt.surrogate.blending import ChebyshevBlend
-from mechopt.surrogate.errors import SurrogateError, SurrogateWarning
-from mechopt.surrogate.exponential_fit import ExponentialFit, fit_exponential
-from mechopt.surrogate.lines import LineHull, LinePlan, normal_basis
-from mechopt.surrogate.model import SparseExponentialModel
-from mechopt.surrogate.planner import PlanResult, coverage, plan_lines
-from mechopt.surrogate.search import HullGrid, SearchResult, exhaustive_search, grid_minimum, hull_grid
+import importlib
+from typing import Any
+
+# Imported on first use: the search module compiles numba kernels and pulls scipy.spatial, seconds that a command
+# which only names SurrogateError (every command line) should not pay.
+_HOME = {
+    "ChebyshevBlend": "blending", "SurrogateError": "errors", "SurrogateWarning": "errors",
+    "ExponentialFit": "exponential_fit", "fit_exponential": "exponential_fit", "LineHull": "lines",
+    "LinePlan": "lines", "normal_basis": "lines", "SparseExponentialModel": "model", "PlanResult": "planner",
+    "coverage": "planner", "plan_lines": "planner", "HullGrid": "search", "SearchResult": "search",
+    "exhaustive_search": "search", "grid_minimum": "search", "hull_grid": "search",
+}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _HOME:
+        return getattr(importlib.import_module(f"mechopt.surrogate.{_HOME[name]}"), name)
+    raise AttributeError(f"module 'mechopt.surrogate' has no attribute {name!r}")
+
 
 __all__ = [
     "ChebyshevBlend",

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from mechopt.optimize.baselines.torch_threads import one_torch_thread
+
 __all__ = ["run_qlognehvi"]
 
 
@@ -37,6 +39,14 @@ def run_qlognehvi(counted, bounds: np.ndarray, budget: int, seed: int) -> None: 
         Seed of the Sobol start and of the optimiser's restarts.
     """
     import torch
+
+    torch.manual_seed(seed)
+    with one_torch_thread():
+        _loop(counted, bounds, budget, seed)
+
+
+def _loop(counted, bounds: np.ndarray, budget: int, seed: int) -> None:  # noqa: ANN001
+    import torch
     from botorch.acquisition.multi_objective.logei import qLogNoisyExpectedHypervolumeImprovement
     from botorch.acquisition.multi_objective.objective import IdentityMCMultiOutputObjective
     from botorch.fit import fit_gpytorch_mll
@@ -47,7 +57,6 @@ def run_qlognehvi(counted, bounds: np.ndarray, budget: int, seed: int) -> None: 
     from gpytorch.mlls import SumMarginalLogLikelihood
     from scipy.stats import qmc
 
-    torch.manual_seed(seed)
     d, k, c = bounds.shape[0], counted.spec.k, counted.n_constraints
     lo, width = bounds[:, 0], bounds[:, 1] - bounds[:, 0]
     U = qmc.Sobol(d, seed=seed).random(min(budget, 2 * (d + 1)))

@@ -141,8 +141,11 @@ def optuna_gp(problem: DesignProblem, budget: int, seed: int) -> PeerRun:
     """Optuna's GPSampler (log expected hypervolume improvement with several objectives), needs PyTorch."""
     import optuna
 
-    return _optuna(problem, budget, seed,
-                   lambda s, c: optuna.samplers.GPSampler(seed=s, constraints_func=c, deterministic_objective=True))
+    from mechopt.optimize.baselines.torch_threads import one_torch_thread
+
+    with one_torch_thread():
+        return _optuna(problem, budget, seed, lambda s, c: optuna.samplers.GPSampler(
+            seed=s, constraints_func=c, deterministic_objective=True))
 
 
 def botorch_qlognehvi(problem: DesignProblem, budget: int, seed: int) -> PeerRun:

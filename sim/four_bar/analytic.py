@@ -70,23 +70,40 @@ def _curve(oa, ab, bc, xc, yc, branch, j0, ir, mc, psi, psid, psidd, load, tau):
         )
 
 
+@njit(cache=True)
+def _design_rms_peak(designs_m, i, xc, yc, branch, j0, ir, mc, cpsi, spsi, psid, psidd, load, weights, period, out):
+    oa = designs_m[i, 0]
+    ab = designs_m[i, 1]
+    bc = designs_m[i, 2]
+    acc = 0.0
+    peak = 0.0
+    for k in range(cpsi.size):
+        tau = _torque_kernel(oa, ab, bc, xc, yc, branch, j0, ir, mc, cpsi[k], spsi[k], psid[k], psidd[k], load[k])
+        acc += weights[k] * tau * tau
+        a = abs(tau)
+        if a > peak or np.isnan(a):
+            peak = a
+    out[i, 0] = np.sqrt(acc / period)
+    out[i, 1] = peak
+
+
 @njit(cache=True, parallel=True)
 def _batch(designs_m, xc, yc, branch, j0, ir, mc, cpsi, spsi, psid, psidd, load, weights, period, out):
-    """T_RMS and T_max of many designs on one shared time grid (trapezoid weights)."""
+    """T_RMS and T_max of many designs on one shared time grid (trapezoid weights), parallel over designs."""
     for i in prange(designs_m.shape[0]):
-        oa = designs_m[i, 0]
-        ab = designs_m[i, 1]
-        bc = designs_m[i, 2]
-        acc = 0.0
-        peak = 0.0
-        for k in range(cpsi.size):
-            tau = _torque_kernel(oa, ab, bc, xc, yc, branch, j0, ir, mc, cpsi[k], spsi[k], psid[k], psidd[k], load[k])
-            acc += weights[k] * tau * tau
-            a = abs(tau)
-            if a > peak or np.isnan(a):
-                peak = a
-        out[i, 0] = np.sqrt(acc / period)
-        out[i, 1] = peak
+        _design_rms_peak(designs_m, i, xc, yc, branch, j0, ir, mc, cpsi, spsi, psid, psidd, load, weights, period, out)
+
+
+@njit(cache=True)
+def _batch_few(designs_m, xc, yc, branch, j0, ir, mc, cpsi, spsi, psid, psidd, load, weights, period, out):
+    """:func:`_batch` on one thread."""
+    for i in range(designs_m.shape[0]):
+        _design_rms_peak(designs_m, i, xc, yc, branch, j0, ir, mc, cpsi, spsi, psid, psidd, load, weights, period, out)
+
+
+#: Below this many designs the batch runs on one thread: waking numba's thread pool costs milliseconds on a busy
+#: machine, more than a few designs' work.
+_PARALLEL_FROM = 256
 
 
 def _load_on_grid(mechanism: FourBar, psi: np.ndarray) -> np.ndarray:
@@ -192,7 +209,8 @@ def analytic_batch(
     weights[[0, -1]] *= 0.5
     out = np.empty((arr.shape[0], 2))
     xc, yc = (v * MM for v in mechanism.pivot_c)
-    _batch(
+    kernel = _batch if arr.shape[0] >= _PARALLEL_FROM else _batch_few
+    kernel(
         np.ascontiguousarray(arr * MM), xc, yc, mechanism.branch, mechanism.j0, mechanism.i_r,
         mechanism.coupler_mass, np.cos(psi), np.sin(psi), psid, psidd, load, weights, float(t[-1] - t[0]), out,
     )

@@ -92,6 +92,20 @@ def _margins_many(designs, xc, yc, psi_start, psi_end, branch, zeta_min, cpsi, s
         )
 
 
+@njit(cache=True)
+def _margins_few(designs, xc, yc, psi_start, psi_end, branch, zeta_min, cpsi, spsi, out):
+    for i in range(designs.shape[0]):
+        _design_margins(
+            designs[i, 0], designs[i, 1], designs[i, 2], xc, yc, psi_start, psi_end, branch, zeta_min, cpsi, spsi,
+            out[i],
+        )
+
+
+#: Below this many designs the margins run on one thread: waking numba's thread pool costs milliseconds on a busy
+#: machine, a hundred times one design's work (an optimizer's finite differences ask for one design at a time).
+_PARALLEL_FROM = 4096
+
+
 @dataclass(frozen=True)
 class FeasibilityReport:
     """Constraint margins of a batch of designs (positive = satisfied).
@@ -191,7 +205,8 @@ def check_feasibility(designs: np.ndarray, mechanism: FourBar, n_check: int = N_
     out = np.empty((arr.shape[0], len(MARGIN_NAMES)))
     xc, yc = mechanism.pivot_c
     psi = np.linspace(mechanism.psi_start, mechanism.psi_end, int(n_check))
-    _margins_many(
+    kernel = _margins_many if arr.shape[0] >= _PARALLEL_FROM else _margins_few
+    kernel(
         arr, xc, yc, mechanism.psi_start, mechanism.psi_end, mechanism.branch,
         np.radians(mechanism.toggle_margin_deg), np.cos(psi), np.sin(psi), out,
     )

@@ -127,8 +127,6 @@ def plot_mechanisms(designs: dict[str, np.ndarray], mechanism: FourBar, path: st
 
 def animate_cycle(result: SimulationResult, mechanism: FourBar, path: str | Path, frames: int = 40) -> Path:
     """Animated GIF of a design through its cycle, with the torque trace growing beside it."""
-    from matplotlib.animation import FuncAnimation, PillowWriter
-
     path = figure_path(path, (".gif",))
     mech = mechanism
     idx = np.linspace(0, result.t.size - 1, frames).astype(int)
@@ -160,7 +158,20 @@ def animate_cycle(result: SimulationResult, mechanism: FourBar, path: str | Path
         dot.set_data([result.t[k]], [result.tau[k]])
         return link, trace, dot
 
-    anim = FuncAnimation(fig, update, frames=frames, blit=True)
-    anim.save(path, writer=PillowWriter(fps=12))
+    # The still parts are drawn once and each frame only redraws the moving artists over them (blitting by hand):
+    # matplotlib's writer redraws the whole figure per frame, which made this GIF most of a small study's time.
+    from PIL import Image
+
+    fig.canvas.draw()
+    background = fig.canvas.copy_from_bbox(fig.bbox)
+    images = []
+    for f in range(frames):
+        fig.canvas.restore_region(background)
+        for artist in update(f):
+            artist.axes.draw_artist(artist)
+        images.append(Image.fromarray(np.asarray(fig.canvas.buffer_rgba())[..., :3].copy()))
+    palette = images[-1].quantize(colors=64)  # the last frame holds every colour; one palette keeps them steady
+    frames_p = [im.quantize(palette=palette) for im in images]
+    frames_p[0].save(path, save_all=True, append_images=frames_p[1:], duration=round(1000 / 12), loop=0)
     plt.close(fig)
     return path

@@ -84,3 +84,14 @@ def test_bad_objective_or_limit_is_one_line(tmp_path, flags, words):
     assert proc.returncode != 0 and "Traceback" not in err and len(err.splitlines()) == 1, err
     assert words in err
     assert not (tmp_path / "run").exists()
+
+
+def test_a_listed_test_problem_runs_as_a_study_and_compare_refuses_it_in_one_line(tmp_path):
+    # `mechopt studies` lists the multi-objective test problems and says "run one with `mechopt study NAME`".
+    proc = mechopt("study", "bnh", "--budget", "16", "--workers", "1", "--no-progress", "--out", str(tmp_path / "b"))
+    assert proc.returncode == 0, proc.stderr
+    rows = list(csv.DictReader((tmp_path / "b" / "front.csv").open()))
+    assert rows and all(float(r["c1"]) <= 0.0 and float(r["c2"]) <= 0.0 for r in rows)
+    proc = mechopt("compare", "--study", "bnh", "--budgets", "20", "--seeds", "1", "--out", str(tmp_path / "c"))
+    assert proc.returncode != 0 and "has 2 objectives" in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "c").exists()
