@@ -66,9 +66,9 @@ class Method:
     max_objectives : int
         Most objectives it minimises at once.
     discrete : bool
-        Whether it declares discrete variables (grids, integers, catalogues) in its own terms (a library's integer
-        and categorical variables, mechopt's allowed designs); every method's proposals are snapped to the allowed
-        designs anyway.
+        Whether it searches discrete variables (grids, integers, catalogues) its own way: the default method's
+        acquisition over allowed designs, a library's integer and categorical parameters.  Every method is given
+        allowed designs only (the sampler snaps each proposal before it is simulated); the others see a relaxed box.
     options : tuple of Option, optional
         Its declared options; None: the keyword-only parameters of ``function``.
     line_model : bool
@@ -149,7 +149,7 @@ def _own_records() -> list[Method]:
                "beyond, or Gauss-Newton runs from multi-level single linkage starts when the problem declares "
                "residuals; failed simulations learned and avoided", own=True, dims=(1, None), batches=True,
                min_budget=lambda dim, budget, n_lines: (auto_min_budget(dim), "2d + 2"), options=(),
-               starts_from_x0=True, compare_name="mechopt-auto", max_objectives=MAX_OBJECTIVES),
+               starts_from_x0=True, compare_name="mechopt-auto", max_objectives=MAX_OBJECTIVES, discrete=True),
         Method("sparse", run_sparse, "paper 002's line model: lines sampled, fitted by sums of exponentials, blended "
                "by Chebyshev interpolation, searched exhaustively, refined on the simulator (smooth landscapes)",
                own=True, dims=(2, 4), batches=True, min_budget=_sparse_min_budget, options=SparseOptions.DECLARED,

@@ -16,7 +16,7 @@ from scipy.optimize import minimize
 from scipy.special import ndtr
 from scipy.stats import qmc
 
-from mechopt.optimize.auto.design_grid import DesignGrid
+from mechopt.optimize.auto.design_grid import ENUMERATE_MAX, DesignGrid
 from mechopt.optimize.auto.gp import GaussianProcess
 
 __all__ = ["log_expected_improvement", "propose_batch", "thompson_batch"]
@@ -99,8 +99,8 @@ def _maximise(score: Callable[[np.ndarray], np.ndarray], lo: np.ndarray, hi: np.
     s = score(C)
     order = np.argsort(-s)
     best_x, best_s = C[order[0]], s[order[0]]
-    if grid is not None and grid.all_discrete:
-        return np.asarray(best_x, dtype=float)
+    if grid is not None and grid.count is not None and grid.count <= ENUMERATE_MAX:
+        return np.asarray(best_x, dtype=float)  # every allowed design of the box was scored
     fun, bounds = _with_gradient(score, lo, hi), list(zip(lo, hi, strict=True))
     if margins is None:
         method, extra = "L-BFGS-B", {"options": {"maxiter": 30}}
@@ -109,13 +109,32 @@ def _maximise(score: Callable[[np.ndarray], np.ndarray], lo: np.ndarray, hi: np.
         method, extra = "SLSQP", {"options": {"maxiter": 50}, "constraints": [
             {"type": "ineq", "fun": lambda u: margins(u[None, :])[0] - _MARGIN_EPS}]}
     for x0 in C[order[:polish]]:
-        if grid is not None:
-            bounds = grid.polish_bounds(x0, lo, hi)
         res = minimize(fun, x0, jac=True, method=method, bounds=bounds, **extra)
-        x = np.clip(res.x, lo, hi) if grid is None else grid.snap(np.clip(res.x, lo, hi))[0]
+        if grid is not None:
+            x, s_x = _allowed_near(score, grid, np.clip(res.x, lo, hi), allowed)
+            if s_x > best_s:
+                best_x, best_s = x, s_x
+            continue
+        x = np.clip(res.x, lo, hi)
         if np.isfinite(res.fun) and -res.fun > best_s and allowed(x[None, :])[0]:
             best_x, best_s = x, -res.fun
     return np.asarray(best_x, dtype=float)
+
+
+def _allowed_near(score: Callable[[np.ndarray], np.ndarray], grid: DesignGrid, x: np.ndarray,
+                  allowed: Callable[[np.ndarray], np.ndarray]) -> tuple[np.ndarray, float]:
+    """The best-scoring allowed design among the neighbours of a relaxed optimum ``x`` (one allowed value on each
+    side of each discrete variable; continuous ones kept): relaxation, then rounding by the acquisition itself.
+    A polish on the declared constraints' margins ends on the constraint, and the rounding then picks the allowed
+    design beside it that is feasible, which a plain rounding would often not be."""
+    N = grid.neighbourhood(x, radius=1)
+    N = N[allowed(N)]
+    if not N.shape[0]:
+        return x, -math.inf
+    s = score(N)
+    s = np.where(np.isfinite(s), s, -math.inf)
+    i = int(np.argmax(s))
+    return N[i], float(s[i])
 
 
 def propose_batch(gp: GaussianProcess, best: float, lo: np.ndarray, hi: np.ndarray, centre: np.ndarray, q: int,

@@ -2,8 +2,9 @@
 
 The Gaussian process models the objective over the box as if every variable were continuous (a relaxation); the
 acquisition is then maximised over allowed designs only: candidates are moved to their nearest allowed design
-before they are scored, the gradient polish moves only the continuous variables, and local moves on a discrete
-variable go to its neighbouring values.  When the space holds few designs (:data:`ENUMERATE_MAX`) every one of them
+before they are scored, a gradient polish of the relaxed acquisition is followed by a choice among the allowed
+designs around its end (scored by the acquisition), and local moves on a discrete variable go to its neighbouring
+values.  When the space holds few designs (:data:`ENUMERATE_MAX`) every one of them
 is a candidate.
 """
 
@@ -114,12 +115,6 @@ class DesignGrid:
         S = np.vstack([self.snap(C), self.neighbourhood(centre)])
         inside = np.all((S >= lo - 1e-12) & (S <= hi + 1e-12), axis=1)
         return unique_rows(S[inside])
-
-    def polish_bounds(self, u: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> list[tuple[float, float]]:
-        """Bounds of a gradient polish from ``u``: the box on continuous variables, ``u``'s value held on discrete
-        ones (a gradient step never leaves the allowed values)."""
-        return [(float(u[j]), float(u[j])) if self.mask[j] else (float(lo[j]), float(hi[j]))
-                for j in range(self.mask.size)]
 
 
 def unique_rows(U: np.ndarray) -> np.ndarray:
