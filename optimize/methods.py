@@ -139,6 +139,8 @@ def _at_most(limit: int) -> Callable[[int], int]:
 #: The Bayesian baseline refits a Gaussian process on every sample at every step (cubic cost): ``mechopt compare``
 #: runs it up to this budget, as the literature uses it for small budgets.
 BAYESIAN_MAX_BUDGET = 200
+#: Optuna's GPSampler and BoTorch refit their processes at every step: 300 (10-D) takes minutes a run.
+GP_PEER_MAX_BUDGET = 300
 
 
 def _own_records() -> list[Method]:
@@ -211,6 +213,15 @@ def _baseline_records() -> list[Method]:
                "simulated", **library),
         Method("nevergrad_cma", bl.minimize_nevergrad_cma, "nevergrad's CMA-ES (pycma); nevergrad's cheap-constraint "
                "resampling, leftovers penalised, not simulated", **library),
+        Method("py_bobyqa", bl.minimize_py_bobyqa, "Py-BOBYQA (Cartis et al. 2019; Powell's BOBYQA), quadratic models "
+               "on 2d + 1 points in a trust region, its own restarts; infeasible iterates continued from the last "
+               "feasible one, not simulated", **library),
+        Method("optuna_gp", bl.minimize_optuna_gp, "Optuna's GPSampler, Matern-5/2 ARD process and log expected "
+               "improvement, ask/tell (gp-peers extra); Optuna's constraint models, infeasible trials told a "
+               "penalty, not simulated", max_budget=_at_most(GP_PEER_MAX_BUDGET), **library),
+        Method("botorch_qlognei", bl.minimize_botorch_qlognei, "BoTorch's qLogNoisyExpectedImprovement (Ament et al. "
+               "2023) on SingleTaskGP, BoTorch's own loop (gp-peers extra); margins modelled as outputs, infeasible "
+               "proposals not simulated", max_budget=_at_most(GP_PEER_MAX_BUDGET), **library),
     ]
 
 

@@ -462,3 +462,5 @@ SUITE: dict[str, type[TestFunction]] = {
                               Ackley8)
 }
 
+# The valleys build on TestFunction and add themselves to SUITE; they live in their own module.
+from mechopt.studies import valley_functions  # noqa: E402, F401

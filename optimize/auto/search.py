@@ -22,6 +22,7 @@ from mechopt.optimize.auto.gp import GaussianProcess
 from mechopt.optimize.auto.least_squares_plan import least_squares_plan
 from mechopt.optimize.auto.plan import GLOBAL_MAX_POINTS, Plan, choose_plan
 from mechopt.optimize.auto.polish import nearest_feasible, polish_on_constraints
+from mechopt.optimize.auto.quadratic_steps import QuadraticSteps
 from mechopt.optimize.auto.run_state import BatchEvaluator, Predicate, ResidualBatchEvaluator
 from mechopt.optimize.auto.run_state import SearchRun as _Run
 from mechopt.optimize.auto.trust_region import TrustRegion
@@ -89,7 +90,7 @@ def _initial_design(run: _Run, n: int) -> np.ndarray:
 def _global_plan(run: _Run, plan: Plan) -> None:
     d = run.U.shape[1]
     ones, zeros = np.ones(d), np.zeros(d)
-    probed = False
+    probed, steps = False, QuadraticSteps(d)
     while run.remaining > 0 and not _exhausted(run):
         if run.values.size >= GLOBAL_MAX_POINTS and run.remaining > plan.n_polish:
             # The global GP's fit grows as n³: a large budget goes on with local models (plan.GLOBAL_MAX_POINTS).
@@ -111,12 +112,15 @@ def _global_plan(run: _Run, plan: Plan) -> None:
                 probes = _bound_probes(run, gp, centre, max(1, plan.n_polish // 2))
                 first = np.vstack([first, probes[: k - first.shape[0]]])
         if first.shape[0] < k:
+            first = np.vstack([first, steps.propose(run.U, run.values, run.allowed)])
+        if first.shape[0] < k:
             U = propose_batch(gp, best, lo, hi, centre, k - first.shape[0], run.rng,
                               lambda C, taken=first: run.allowed(C) & _apart(C, taken), run.success_model(gp),
                               kappa=kappa, margins=run.unit_margins, grid=run.grid)
             first = np.vstack([first, U])
         n0 = run.values.size
         run.simulate(run.fill(first, k))
+        steps.learn(run.U[n0:], run.values[n0:])
         if run.grid is not None and run.values.size == n0:
             return  # no allowed design is left that was not simulated
 

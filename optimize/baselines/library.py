@@ -15,16 +15,17 @@ import numpy as np
 from mechopt.errors import MechoptError
 from mechopt.optimize.budget import CountedProblem
 
-__all__ = ["INSTALL_HINT", "MissingLibraryError", "rejected_value", "require", "worst_feasible_value"]
+__all__ = ["GP_PEERS_HINT", "INSTALL_HINT", "MissingLibraryError", "rejected_value", "require", "worst_feasible_value"]
 
 INSTALL_HINT = "install the compare extra: pip install 'mechopt[compare]'"
+GP_PEERS_HINT = "install the gp-peers extra (PyTorch 2.13.0, CPU): pip install 'mechopt[gp-peers]'"
 
 
 class MissingLibraryError(MechoptError, ImportError):
     """An optional optimizer library (or one of its own optional dependencies) is not installed."""
 
 
-def require(module: str, purpose: str) -> ModuleType:
+def require(module: str, purpose: str, hint: str = INSTALL_HINT) -> ModuleType:
     """Import an optional library or raise a one-line :class:`MissingLibraryError`.
 
     Parameters
@@ -33,6 +34,8 @@ def require(module: str, purpose: str) -> ModuleType:
         Dotted module name, e.g. ``"optuna"`` or ``"pymoo.algorithms.soo.nonconvex.ga"``.
     purpose : str
         Baseline that needs it, for the message (e.g. ``"optuna_tpe"``).
+    hint : str, optional
+        How to install it, default the ``compare`` extra.
 
     Returns
     -------
@@ -43,7 +46,7 @@ def require(module: str, purpose: str) -> ModuleType:
         return importlib.import_module(module)
     except ImportError as exc:
         missing = getattr(exc, "name", None) or module
-        raise MissingLibraryError(f"{purpose} needs the package {missing!r}; {INSTALL_HINT}") from None
+        raise MissingLibraryError(f"{purpose} needs the package {missing!r}; {hint}") from None
 
 
 def worst_feasible_value(problem: CountedProblem) -> float:

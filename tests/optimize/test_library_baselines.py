@@ -67,14 +67,19 @@ def make(budget: int, margins=quad_margins, f=quad, **kw) -> tuple[CountedProble
 
 
 HAS_CMAES = importlib.util.find_spec("cmaes") is not None
+HAS_PYBOBYQA = importlib.util.find_spec("pybobyqa") is not None
 #: Small SMT configuration: 2 Kriging hyperparameter starts instead of 10 (the method is unchanged).
 EGO_TEST = {"krg_options": {"n_start": 2}}
-CHEAP = sorted(set(LIBRARY_BASELINES) - {"smt_ego"})
+#: Optuna's GPSampler and BoTorch refit processes at every step: tested on small budgets in test_gp_peers.py.
+GP_PEERS = {"optuna_gp", "botorch_qlognei"}
+CHEAP = sorted(set(LIBRARY_BASELINES) - {"smt_ego"} - GP_PEERS)
 
 
 def run(name: str, problem: CountedProblem, seed: int):
     if name == "optuna_cmaes" and not HAS_CMAES:
         pytest.skip("Optuna's CMA-ES sampler needs the package cmaes (part of the compare extra)")
+    if name == "py_bobyqa" and not HAS_PYBOBYQA:
+        pytest.skip("py_bobyqa needs the package Py-BOBYQA (part of the compare extra)")
     return BASELINES[name](problem, seed, **(EGO_TEST if name == "smt_ego" else {}))
 
 
@@ -88,14 +93,14 @@ def random_search_gap(budget: int, seed: int, margins=quad_margins, fstar: float
 # --------------------------------------------------------------------------- registry and optional import
 def test_registry_holds_the_library_baselines_beside_the_in_house_ones() -> None:
     assert set(LIBRARY_BASELINES) == {"optuna_tpe", "optuna_cmaes", "smt_ego", "pymoo_ga", "pymoo_pso", "pymoo_de",
-                                      "nevergrad_ngopt", "nevergrad_cma"}
+                                      "nevergrad_ngopt", "nevergrad_cma", "py_bobyqa", "optuna_gp", "botorch_qlognei"}
     assert all(METHODS[name].summary and not METHODS[name].own for name in LIBRARY_BASELINES)
 
 
 FIRST_IMPORT = {"optuna_tpe": "optuna", "optuna_cmaes": "optuna", "smt_ego": "smt.applications",
                 "pymoo_ga": "pymoo.algorithms.soo.nonconvex.ga", "pymoo_pso": "pymoo.algorithms.soo.nonconvex.pso",
                 "pymoo_de": "pymoo.algorithms.soo.nonconvex.de", "nevergrad_ngopt": "nevergrad",
-                "nevergrad_cma": "nevergrad"}
+                "nevergrad_cma": "nevergrad", "py_bobyqa": "pybobyqa"}
 
 
 @pytest.mark.parametrize("name", sorted(FIRST_IMPORT))
