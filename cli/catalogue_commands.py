@@ -39,6 +39,20 @@ def multi_objective_rows() -> list[tuple[str, str, str]]:
     return rows
 
 
+def mixed_variable_rows() -> list[tuple[str, str, str]]:
+    """``(name, kind, description)`` of every test problem with discrete variables."""
+    from mechopt.studies.mixed_variable_functions import MIXED_SUITE
+
+    rows = []
+    for name, cls in sorted(MIXED_SUITE.items()):
+        p = cls()
+        kinds = ", ".join(f"{sum(v.kind == k for v in p.variables)} {k}" for k in ("continuous", "grid", "integer",
+                                                                                   "catalogue")
+                          if any(v.kind == k for v in p.variables))
+        rows.append((name, f"test problem, {p.dim} variables ({kinds})", cls.summary()))
+    return rows
+
+
 def study_lines() -> list[str]:
     """``name  kind, d variables: description`` for every packaged study, then every test function.
 
@@ -56,7 +70,7 @@ def study_lines() -> list[str]:
         rows.append((name, f"{config.get('kind', '?')}, {dim} variables", str(config.get("description", ""))))
     for name, cls in sorted(SUITE.items()):
         rows.append((name, f"test function, {cls().dim} variables", cls.summary()))
-    rows += multi_objective_rows()
+    rows += multi_objective_rows() + mixed_variable_rows()
     width = max(len(r[0]) for r in rows)
     return [f"{name:<{width}}  {what}: {text}" for name, what, text in rows]
 
@@ -106,7 +120,9 @@ def run_init(args: argparse.Namespace, rest: list[str]) -> int:
     from mechopt.studies.catalogue import STUDIES_DIR, packaged_studies
 
     files = packaged_studies()
-    if args.name in SUITE:
+    from mechopt.studies.mixed_variable_functions import MIXED_SUITE
+
+    if args.name in SUITE or args.name in MIXED_SUITE:
         # A test function is a class, not a file: there is nothing to copy, and the list below must not name it.
         raise InputError(f"{args.name!r} is a test function (a Python class), not a study file to copy; expected one "
                          f"of {', '.join(files)}, or define a mechopt.DesignProblem (README: Define your own problem)")

@@ -205,6 +205,7 @@ def run_baseline(call: MethodCall, fn: Callable[..., Any]) -> OptimizeResult:
     counted = CountedProblem(objective, problem.bounds, call.budget, margins if problem.constraints else None,
                              failure_errors=(InfeasibleDesignError,), vectorized_constraints=True,
                              snap=problem.snap if sampler.discrete else None)
+    counted.variables = problem.variables  # the peers declare discrete variables in their libraries' own terms
     try:
         res = fn(counted, call.seed, **call.options)
     finally:

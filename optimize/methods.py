@@ -191,16 +191,19 @@ def _baseline_records() -> list[Method]:
                "and expected improvement (Jones, Schonlau & Welch 1998); infeasible candidates rejected before "
                "simulation", max_budget=_at_most(BAYESIAN_MAX_BUDGET)),
         Method("optuna_tpe", bl.minimize_optuna_tpe, "Optuna's multivariate TPE (Bergstra et al. 2011), ask/tell; "
-               "Optuna's constrained TPE (trial.set_constraint), infeasible trials told as pruned, never simulated",
+               "Optuna's constrained TPE (trial.set_constraint), infeasible trials told as pruned, never simulated; "
+               "discrete variables by suggest_int / suggest_categorical / suggest_float(step=)", discrete=True,
                **library),
         Method("optuna_cmaes", bl.minimize_optuna_cmaes, "Optuna's CMA-ES sampler (Hansen & Ostermeier 2001), "
                "ask/tell; it ignores constraints: infeasible trials not simulated, told a penalty above every "
                "simulated value", **library),
         Method("smt_ego", bl.minimize_smt_ego, "SMT's EGO, Matérn-5/2 Kriging + expected improvement (Jones et al. "
-               "1998); infill maximises EI under the margins (SLSQP), only feasible designs simulated",
-               max_budget=ego_max_budget, **library),
+               "1998); infill maximises EI under the margins (SLSQP), only feasible designs simulated; discrete "
+               "variables by SMT's mixed-integer EGO (IntegerVariable / OrdinalVariable design space)",
+               max_budget=ego_max_budget, discrete=True, **library),
         Method("pymoo_ga", bl.minimize_pymoo_ga, "pymoo GA, SBX + polynomial mutation, elitist survival (Deb 2001); "
-               "feasibility-first tournament and survival (Deb 2000), infeasible designs not simulated", **library),
+               "feasibility-first tournament and survival (Deb 2000), infeasible designs not simulated; discrete "
+               "variables by pymoo's MixedVariableGA (Real / Integer / Choice)", discrete=True, **library),
         Method("pymoo_pso", bl.minimize_pymoo_pso, "pymoo adaptive PSO (Zhan et al. 2009); feasibility-first "
                "personal/global bests, infeasible designs not simulated", **library),
         Method("pymoo_de", bl.minimize_pymoo_de, "pymoo DE/best/1/bin, F 0.5, CR 0.9 (Storn & Price 1997); "

@@ -108,10 +108,11 @@ def available_studies() -> list[str]:
 
 def _test_suites() -> list[tuple[str, dict[str, Any], Path]]:
     """``(kind, {name: problem class}, module file)`` of each registry of test problems."""
-    from mechopt.studies import benchmark_functions, multi_objective_functions
+    from mechopt.studies import benchmark_functions, mixed_variable_functions, multi_objective_functions
 
     return [("test-function", benchmark_functions.SUITE, Path(benchmark_functions.__file__)),
-            ("test-problem", multi_objective_functions.MULTI_OBJECTIVE_SUITE, Path(multi_objective_functions.__file__))]
+            ("test-problem", multi_objective_functions.MULTI_OBJECTIVE_SUITE, Path(multi_objective_functions.__file__)),
+            ("test-function", mixed_variable_functions.MIXED_SUITE, Path(mixed_variable_functions.__file__))]
 
 
 def _suite_study(name: str) -> Study | None:

@@ -127,7 +127,11 @@ def _global_plan(run: _Run, plan: Plan) -> None:
         n0 = run.values.size
         run.simulate(run.fill(first, k))
         if run.grid is not None and run.values.size == n0:
-            return  # no allowed design is left that was not simulated
+            # Every proposal rounded onto a design already simulated: spread the round over fresh allowed designs
+            # instead (a space with a continuous variable is not exhausted); none left means the space is.
+            run.simulate(run.fill(np.zeros((0, d)), k))
+            if run.values.size == n0:
+                return
         steps.learn(run.U[n0:], run.values[n0:])
 
 

@@ -31,6 +31,11 @@ minimum lies on a linear constraint (tests/optimize/test_baselines.py, QUAD), 20
 with resampling and 2.5e-3 with the penalty (seeds 0-2), 500 calls 1.4e-5 and 1e-7.
 
 A failed simulation is told as ``FAIL`` in both schemes.
+
+Discrete variables are declared as Optuna documents them (:mod:`~mechopt.optimize.baselines.mixed_space`): an
+integer as ``IntDistribution`` (``suggest_int``), a catalogue as ``CategoricalDistribution`` (``suggest_categorical``),
+a drawing grid as ``FloatDistribution(step=)`` (``suggest_float(step=)``), so every trial is an allowed design.  A
+trial that repeats a simulated design is told its stored value (the counted problem does not simulate it again).
 """
 
 from __future__ import annotations
@@ -39,11 +44,11 @@ import math
 import warnings
 from typing import Any
 
-import numpy as np
 from scipy.optimize import OptimizeResult
 
 from mechopt.errors import InputError
 from mechopt.optimize.baselines.library import rejected_value, require
+from mechopt.optimize.baselines.mixed_space import from_optuna, optuna_space
 from mechopt.optimize.budget import BudgetExhausted, CountedProblem
 
 __all__ = ["minimize_optuna_cmaes", "minimize_optuna_tpe"]
@@ -58,9 +63,7 @@ def _silenced(optuna: Any) -> int:
 def _run(problem: CountedProblem, optuna: Any, sampler: Any, *, constraints: bool, infeasible: str) -> OptimizeResult:
     """Ask/tell loop shared by the samplers; returns the problem's result."""
     TrialState = optuna.trial.TrialState
-    names = [f"x{i}" for i in range(problem.dim)]
-    space = {n: optuna.distributions.FloatDistribution(float(lo), float(hi))
-             for n, lo, hi in zip(names, problem.lower, problem.upper, strict=True)}
+    space = optuna_space(optuna, problem)
     study = optuna.create_study(direction="minimize", sampler=sampler)
     n_trials = n_rejected = 0
     message = "budget spent"
@@ -68,7 +71,7 @@ def _run(problem: CountedProblem, optuna: Any, sampler: Any, *, constraints: boo
         while problem.remaining > 0:
             trial = study.ask(space)
             n_trials += 1
-            x = np.array([trial.params[n] for n in names])
+            x = from_optuna(problem, trial.params)
             ok = bool(problem.feasible(x)[0])
             if constraints:
                 for j, g in enumerate(problem.margins(x)):

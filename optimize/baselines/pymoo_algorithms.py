@@ -38,6 +38,7 @@ import numpy as np
 from scipy.optimize import OptimizeResult
 
 from mechopt.optimize.baselines.library import require
+from mechopt.optimize.baselines.mixed_space import has_discrete
 from mechopt.optimize.budget import BudgetExhausted, CountedProblem
 
 __all__ = ["default_pop_size", "minimize_pymoo_de", "minimize_pymoo_ga", "minimize_pymoo_pso"]
@@ -131,7 +132,18 @@ def minimize_pymoo_ga(
     scipy.optimize.OptimizeResult
         Best feasible simulated design (``x``, ``fun``), ``nfev``, ``success``, ``message``, ``ngen`` (ask/tell
         rounds, the first being the initial population).
+
+    Notes
+    -----
+    On a problem with discrete variables this is pymoo's ``MixedVariableGA``
+    (:func:`~mechopt.optimize.baselines.pymoo_mixed_ga.minimize_pymoo_mixed_ga`, pymoo's own operators per kind of
+    variable; the SBX and mutation options here do not apply).
     """
+    if has_discrete(problem):
+        # Imported here: that module reads default_pop_size of this one.
+        from mechopt.optimize.baselines.pymoo_mixed_ga import minimize_pymoo_mixed_ga
+
+        return minimize_pymoo_mixed_ga(problem, seed, pop_size=pop_size)
     ga = require("pymoo.algorithms.soo.nonconvex.ga", "pymoo_ga")
     sampling = require("pymoo.operators.sampling.lhs", "pymoo_ga")
     sbx = require("pymoo.operators.crossover.sbx", "pymoo_ga")

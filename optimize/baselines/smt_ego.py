@@ -31,6 +31,8 @@ import numpy as np
 from scipy.optimize import OptimizeResult, minimize
 
 from mechopt.optimize.baselines.library import require, worst_feasible_value
+from mechopt.optimize.baselines.mixed_space import has_discrete
+from mechopt.optimize.baselines.smt_mixed_ego import minimize_smt_mixed_ego
 from mechopt.optimize.budget import BudgetExhausted, CountedProblem
 
 __all__ = ["EGO_MAX_BUDGETS", "max_budget", "minimize_smt_ego"]
@@ -123,7 +125,16 @@ def minimize_smt_ego(
     scipy.optimize.OptimizeResult
         Best feasible simulated design (``x``, ``fun``), ``nfev``, ``success``, ``message``, ``nit`` (EGO iterations
         asked of SMT).
+
+    Notes
+    -----
+    On a problem with discrete variables this is SMT's mixed-integer EGO
+    (:func:`~mechopt.optimize.baselines.smt_mixed_ego.minimize_smt_mixed_ego`: SMT's design space of integer and
+    ordinal variables, its default squared-exponential kernel); ``corr`` does not apply there.
     """
+    if has_discrete(problem):
+        return minimize_smt_mixed_ego(problem, seed, n_doe=n_doe, n_start=n_start, n_candidates=n_candidates,
+                                      krg_options=krg_options)
     applications = require("smt.applications", "smt_ego")
     models = require("smt.surrogate_models", "smt_ego")
     design_space = require("smt.design_space", "smt_ego")

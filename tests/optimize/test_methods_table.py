@@ -24,6 +24,8 @@ def test_every_record_is_complete(name):
     m = METHODS[name]
     assert m.name == name and callable(m.function) and m.summary
     assert 1 <= m.max_objectives <= 4 and isinstance(m.discrete, bool)
+    # A method declares discrete variables in its own terms only where a library documents them (or it is ours).
+    assert not m.discrete or m.own or m.spends_whole_budget
     assert m.discrete or name != "auto"  # the default searches allowed designs its own way
     assert (m.max_objectives > 1) == (name == "auto")  # only the default takes trade-offs today
     for dim in (2, 3, 4, 8):
