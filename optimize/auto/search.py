@@ -275,6 +275,30 @@ def _limited_threads() -> contextlib.AbstractContextManager:
     return threadpool_limits(1)
 
 
+def _start(run: _Run, plan: Plan, initial: np.ndarray | None) -> tuple[int, int]:
+    """Simulate the designs of ``initial`` inside the box (on top of the budget), then the space-filling start;
+    returns (Sobol designs planned, designs of ``initial`` simulated)."""
+    n_init, n_x0 = plan.n_init, 0
+    if initial is not None and len(initial):
+        U0 = (np.atleast_2d(np.asarray(initial, dtype=float)) - run.lo) / run.width
+        # Only designs inside the box: the line plan's reach beyond it, clipped onto a face, would be new designs
+        # simulated on top of the budget (7 of 9 of a ventilator plan of 3 lines were).
+        U0 = np.clip(U0[np.all((U0 >= -1e-9) & (U0 <= 1.0 + 1e-9), axis=1)], 0.0, 1.0)
+        run.budget, n_x0 = run.budget + U0.shape[0], U0.shape[0]
+        run.simulate(U0)
+        n_init = max(0, n_init - int(run.ok.sum()))
+    run.simulate(_initial_design(run, n_init))
+    if run.ok.sum() < 2 and plan.name != "least-squares":
+        # Too few successes to fit a model: more space-filling designs, a batch at a time, only until two
+        # succeed (a simulator that fails in most of the box must not turn the whole budget into a Sobol design).
+        more = _initial_design(run, run.remaining)
+        for start in range(0, more.shape[0], plan.batch):
+            if run.ok.sum() >= 2:
+                break
+            run.simulate(more[start: start + plan.batch])
+    return n_init, n_x0
+
+
 def auto_search(evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, seed: int = 0,
                 feasible: Predicate | None = None, batch: int = 1,
                 margins: Callable[[np.ndarray], np.ndarray] | None = None,
@@ -321,24 +345,7 @@ def auto_search(evaluate: BatchEvaluator, bounds: np.ndarray, budget: int, seed:
     plan = choose_plan(d, int(budget), int(batch), least_squares=residuals is not None and grid is None)
     run = _Run(evaluate, bounds, int(budget), feasible, np.random.default_rng(seed), margins, residuals, grid)
     with _limited_threads():
-        n_init, n_x0 = plan.n_init, 0
-        if initial is not None and len(initial):
-            U0 = (np.atleast_2d(np.asarray(initial, dtype=float)) - run.lo) / run.width
-            # Only designs inside the box: the line plan's reach beyond it, clipped onto a face, would be new designs
-            # simulated on top of the budget (7 of 9 of a ventilator plan of 3 lines were).
-            U0 = np.clip(U0[np.all((U0 >= -1e-9) & (U0 <= 1.0 + 1e-9), axis=1)], 0.0, 1.0)
-            run.budget, n_x0 = run.budget + U0.shape[0], U0.shape[0]
-            run.simulate(U0)
-            n_init = max(0, n_init - int(run.ok.sum()))
-        run.simulate(_initial_design(run, n_init))
-        if run.ok.sum() < 2 and plan.name != "least-squares":
-            # Too few successes to fit a model: more space-filling designs, a batch at a time, only until two
-            # succeed (a simulator that fails in most of the box must not turn the whole budget into a Sobol design).
-            more = _initial_design(run, run.remaining)
-            for start in range(0, more.shape[0], plan.batch):
-                if run.ok.sum() >= 2:
-                    break
-                run.simulate(more[start: start + plan.batch])
+        n_init, n_x0 = _start(run, plan, initial)
         # No design at all: none of the thousands tried satisfies the declared constraints (said in the message).
         if run.values.size:
             if plan.name == "least-squares":

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import importlib
 import math
+from collections.abc import Iterable
 from types import ModuleType
 
 import numpy as np
@@ -63,6 +64,31 @@ def worst_feasible_value(problem: CountedProblem) -> float:
     """
     values = [e.f for e in problem.history if e.feasible and math.isfinite(e.f)]
     return max(values) if values else math.nan
+
+
+def kriging_values(problem: CountedProblem, designs: Iterable[np.ndarray]) -> np.ndarray:
+    """Simulated values of designs as a Kriging model takes them, (n, 1): a failed simulation enters at the worst
+    feasible value seen (else ``infeasible_value``), which pushes the search away from it; Kriging needs a number.
+
+    Parameters
+    ----------
+    problem : CountedProblem
+    designs : iterable of (d,) ndarray
+        Designs in the variables' units.
+
+    Returns
+    -------
+    (n, 1) ndarray
+        In the objective's units.
+    """
+    out = []
+    for x in designs:
+        f = problem.evaluate(x)
+        if not math.isfinite(f):
+            worst = worst_feasible_value(problem)
+            f = worst if math.isfinite(worst) else problem.infeasible_value
+        out.append(f)
+    return np.array(out, dtype=float).reshape(-1, 1)
 
 
 def rejected_value(problem: CountedProblem, x: np.ndarray) -> float:

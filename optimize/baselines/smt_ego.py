@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import OptimizeResult, minimize
 
-from mechopt.optimize.baselines.library import require, worst_feasible_value
+from mechopt.optimize.baselines.library import kriging_values, require
 from mechopt.optimize.baselines.mixed_space import has_discrete
 from mechopt.optimize.baselines.smt_mixed_ego import minimize_smt_mixed_ego
 from mechopt.optimize.budget import BudgetExhausted, CountedProblem
@@ -149,15 +149,7 @@ def minimize_smt_ego(
     n_iter = problem.budget - X0.shape[0]
 
     def fun(U: np.ndarray) -> np.ndarray:
-        out = []
-        for u in np.atleast_2d(U):
-            f = problem.evaluate(problem.from_unit(u))
-            if not math.isfinite(f):
-                worst = worst_feasible_value(problem)
-                # Kriging needs a number: the worst value seen pushes the search away from a failed design.
-                f = worst if math.isfinite(worst) else problem.infeasible_value
-            out.append(f)
-        return np.array(out, dtype=float).reshape(-1, 1)
+        return kriging_values(problem, (problem.from_unit(u) for u in np.atleast_2d(U)))
 
     space = design_space.DesignSpace([design_space.FloatVariable(0.0, 1.0) for _ in range(d)], seed=seed)
     options = {"print_global": False, "corr": corr, "seed": seed, "design_space": space, **(krg_options or {})}

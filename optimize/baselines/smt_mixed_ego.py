@@ -23,13 +23,12 @@ allowed, feasible and new.
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
 from scipy.optimize import OptimizeResult, minimize
 
-from mechopt.optimize.baselines.library import require, worst_feasible_value
+from mechopt.optimize.baselines.library import kriging_values, require
 from mechopt.optimize.baselines.mixed_space import allowed_feasible, snap, variables_of
 from mechopt.optimize.budget import BudgetExhausted, CountedProblem
 
@@ -175,14 +174,7 @@ def minimize_smt_mixed_ego(problem: CountedProblem, seed: int, *, n_doe: int | N
     n_iter = problem.budget - X0.shape[0]
 
     def fun(U: np.ndarray) -> np.ndarray:
-        out = []
-        for x in from_folded(problem, U):
-            f = problem.evaluate(x)
-            if not math.isfinite(f):
-                worst = worst_feasible_value(problem)
-                f = worst if math.isfinite(worst) else problem.infeasible_value
-            out.append(f)
-        return np.array(out, dtype=float).reshape(-1, 1)
+        return kriging_values(problem, from_folded(problem, U))
 
     space = smt_design_space(design_space, problem, seed)
     surrogate = models.KRG(**{"print_global": False, "corr": corr, "design_space": space, "seed": seed,
