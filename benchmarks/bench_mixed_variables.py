@@ -6,7 +6,8 @@ Every run goes through ``mechopt compare``'s own :func:`~mechopt.studies.compari
 known value f* at the returned design (NaN when no feasible design was found).  Each design simulated is recorded, so
 the table also says how many were off their grids (must be 0) and how many repeated a design of the same run (must
 be 0).  A peer with a ``max_budget`` in the table of methods (SMT's EGO refits Kriging at every step) is run up to
-``min(max_budget, --cap-model)`` simulations and marked "not run" beyond.
+its ``max_budget`` simulations (``--cap-model`` replaces it, e.g. to run SMT at 100 for a benchmark) and marked "not
+run" beyond.
 
 Every run appends one JSON line to ``--out``; runs already there are skipped, so the benchmark resumes, and
 ``--table`` prints the table from the file.  The loops run budget → seed → problem → method.
@@ -75,11 +76,11 @@ def run(name: str, method: str, budget: int, seed: int) -> dict:
             "wall_s": time.perf_counter() - t0}
 
 
-def _cap(method: str, dim: int, cap_model: int) -> int | None:
+def _cap(method: str, dim: int, cap_model: int | None) -> int | None:
     record = compared_methods().get(method)
     if record is None or record.max_budget is None:
         return None
-    return min(record.max_budget(dim), cap_model)
+    return record.max_budget(dim) if cap_model is None else cap_model
 
 
 def table(rows: list[dict], methods: list[str]) -> str:
@@ -125,7 +126,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--seeds", type=int, default=10)
     ap.add_argument("--problems", nargs="+", default=list(MIXED_SUITE), choices=list(MIXED_SUITE))
     ap.add_argument("--methods", nargs="+", default=[OWN_METHOD, *PEERS])
-    ap.add_argument("--cap-model", type=int, default=50, help="largest budget of a peer that has a max_budget")
+    ap.add_argument("--cap-model", type=int, default=None,
+                    help="largest budget of a peer that has a max_budget (default: that max_budget)")
     ap.add_argument("--out", type=Path, default=Path("bench_mixed.jsonl"))
     ap.add_argument("--table", action="store_true", help="only print the table of --out")
     args = ap.parse_args(argv)

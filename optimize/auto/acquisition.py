@@ -18,6 +18,7 @@ from scipy.stats import qmc
 
 from mechopt.optimize.auto.design_grid import ENUMERATE_MAX, DesignGrid
 from mechopt.optimize.auto.gp import GaussianProcess
+from mechopt.optimize.auto.held_polish import polished_neighbours
 
 __all__ = ["log_expected_improvement", "propose_batch", "thompson_batch"]
 
@@ -108,29 +109,34 @@ def _maximise(score: Callable[[np.ndarray], np.ndarray], lo: np.ndarray, hi: np.
         # A margin a hair above zero: SLSQP stops within its tolerance of the constraint, on either side.
         method, extra = "SLSQP", {"options": {"maxiter": 50}, "constraints": [
             {"type": "ineq", "fun": lambda u: margins(u[None, :])[0] - _MARGIN_EPS}]}
+    ends = []
     for x0 in C[order[:polish]]:
         res = minimize(fun, x0, jac=True, method=method, bounds=bounds, **extra)
         if grid is not None:
-            x, s_x = _allowed_near(score, grid, np.clip(res.x, lo, hi), allowed)
-            if s_x > best_s:
-                best_x, best_s = x, s_x
+            ends.append(np.clip(res.x, lo, hi))
             continue
         x = np.clip(res.x, lo, hi)
         if np.isfinite(res.fun) and -res.fun > best_s and allowed(x[None, :])[0]:
             best_x, best_s = x, -res.fun
+    if ends:
+        x, s_x = _allowed_near(score, grid, np.array(ends), allowed, lo, hi, margins)
+        if s_x > best_s:
+            best_x, best_s = x, s_x
     return np.asarray(best_x, dtype=float)
 
 
-def _allowed_near(score: Callable[[np.ndarray], np.ndarray], grid: DesignGrid, x: np.ndarray,
-                  allowed: Callable[[np.ndarray], np.ndarray]) -> tuple[np.ndarray, float]:
-    """The best-scoring allowed design among the neighbours of a relaxed optimum ``x`` (one allowed value on each
-    side of each discrete variable; continuous ones kept): relaxation, then rounding by the acquisition itself.
-    A polish on the declared constraints' margins ends on the constraint, and the rounding then picks the allowed
-    design beside it that is feasible, which a plain rounding would often not be."""
-    N = grid.neighbourhood(x, radius=1)
+def _allowed_near(score: Callable[[np.ndarray], np.ndarray], grid: DesignGrid, X: np.ndarray,
+                  allowed: Callable[[np.ndarray], np.ndarray], lo: np.ndarray, hi: np.ndarray,
+                  margins: Callable[[np.ndarray], np.ndarray] | None) -> tuple[np.ndarray, float]:
+    """The best-scoring allowed design among the neighbours of relaxed optima ``X`` (one allowed value on each
+    side of each discrete variable, its continuous variables kept or polished with the discrete ones held:
+    :func:`~mechopt.optimize.auto.held_polish.polished_neighbours`): relaxation, then rounding by the acquisition
+    itself.  A polish on the declared constraints' margins ends on the constraint, and the rounding then picks the
+    allowed design beside it that is feasible, which a plain rounding would often not be."""
+    N = polished_neighbours(score, grid, X, lo, hi, 1, margins)
     N = N[allowed(N)]
     if not N.shape[0]:
-        return x, -math.inf
+        return X[0], -math.inf
     s = score(N)
     s = np.where(np.isfinite(s), s, -math.inf)
     i = int(np.argmax(s))

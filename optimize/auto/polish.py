@@ -12,8 +12,9 @@ from collections.abc import Callable
 import numpy as np
 from scipy.optimize import minimize
 
-from mechopt.optimize.auto.design_grid import DesignGrid
+from mechopt.optimize.auto.design_grid import NEIGHBOUR_RADIUS, DesignGrid
 from mechopt.optimize.auto.gp import GaussianProcess
+from mechopt.optimize.auto.held_polish import polished_neighbours
 
 __all__ = ["nearest_feasible", "polish_on_constraints"]
 
@@ -37,9 +38,10 @@ def polish_on_constraints(gp: GaussianProcess, centre: np.ndarray, lo: np.ndarra
     allowed : callable
         Designs that may be simulated (declared constraints, not simulated yet).
     grid : DesignGrid, optional
-        With discrete variables: the relaxed minimiser's neighbouring allowed designs are ranked by the model's
-        mean, and the best one that may be simulated is returned (rounding the minimiser alone would often leave
-        the constraint it lies on).
+        With discrete variables: the relaxed minimiser's neighbouring allowed designs, each also with its
+        continuous variables polished (:func:`~mechopt.optimize.auto.held_polish.polished_neighbours`), are ranked
+        by the model's mean, and the best one that may be simulated is returned (rounding the minimiser alone
+        would often leave the constraint it lies on).
     """
     res = minimize(lambda u: float(gp.predict(u[None, :])[0][0]), centre, method="SLSQP",
                    bounds=list(zip(lo, hi, strict=True)),
@@ -47,7 +49,7 @@ def polish_on_constraints(gp: GaussianProcess, centre: np.ndarray, lo: np.ndarra
                    options={"maxiter": 100, "ftol": 1e-10})
     x = np.clip(res.x, lo, hi)
     if grid is not None:
-        N = grid.neighbourhood(x)
+        N = polished_neighbours(lambda U: -gp.predict(U)[0], grid, x, lo, hi, NEIGHBOUR_RADIUS, margins)
         N = N[allowed(N)]
         return N[int(np.argmin(gp.predict(N)[0]))] if N.shape[0] else None
     return x if allowed(x[None, :])[0] else None
