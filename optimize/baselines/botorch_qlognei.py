@@ -26,6 +26,7 @@ import numpy as np
 from scipy.optimize import OptimizeResult
 
 from mechopt.optimize.baselines.library import GP_PEERS_HINT, rejected_value, require
+from mechopt.optimize.baselines.torch_threads import one_torch_thread
 from mechopt.optimize.budget import BudgetExhausted, CountedProblem
 
 __all__ = ["minimize_botorch_qlognei"]
@@ -108,8 +109,6 @@ def minimize_botorch_qlognei(
     """
     torch = require("torch", "botorch_qlognei", GP_PEERS_HINT)
     require("botorch", "botorch_qlognei", GP_PEERS_HINT)
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
     torch.manual_seed(seed)
     rng = np.random.default_rng(seed)
     d = problem.dim
@@ -117,20 +116,19 @@ def minimize_botorch_qlognei(
     # BoTorch's draw_sobol_samples: PyTorch's scrambled Sobol engine.
     U = torch.quasirandom.SobolEngine(d, scramble=True, seed=seed).draw(n_initial or 2 * (d + 1)).double().numpy()
     rows: list[np.ndarray] = []
-    try:
-        for u in U:
-            rows.append(_observe(problem, u)[0])
-        while problem.remaining > 0:
-            u = _candidate(torch, U, np.array(rows), seed + steps, num_restarts, raw_samples)
-            steps += 1
-            if np.min(np.max(np.abs(U - u), axis=1)) < 1e-9:
-                replaced += 1
-                fresh = problem.sample_feasible(1, rng)
-                u = problem.to_unit(fresh[0]) if fresh.shape[0] else rng.random(d)
-            y, _ = _observe(problem, u)
-            U, rows = np.vstack([U, u]), [*rows, y]
-    except BudgetExhausted as exc:
-        message = str(exc)
-    finally:
-        torch.set_num_threads(threads)
+    with one_torch_thread():
+        try:
+            for u in U:
+                rows.append(_observe(problem, u)[0])
+            while problem.remaining > 0:
+                u = _candidate(torch, U, np.array(rows), seed + steps, num_restarts, raw_samples)
+                steps += 1
+                if np.min(np.max(np.abs(U - u), axis=1)) < 1e-9:
+                    replaced += 1
+                    fresh = problem.sample_feasible(1, rng)
+                    u = problem.to_unit(fresh[0]) if fresh.shape[0] else rng.random(d)
+                y, _ = _observe(problem, u)
+                U, rows = np.vstack([U, u]), [*rows, y]
+        except BudgetExhausted as exc:
+            message = str(exc)
     return problem.result(message, nsteps=steps, nreplaced=replaced)

@@ -26,6 +26,7 @@ from scipy.optimize import OptimizeResult
 
 from mechopt.optimize.baselines.library import GP_PEERS_HINT, rejected_value, require
 from mechopt.optimize.baselines.optuna_samplers import _silenced
+from mechopt.optimize.baselines.torch_threads import one_torch_thread
 from mechopt.optimize.budget import BudgetExhausted, CountedProblem
 
 __all__ = ["minimize_optuna_gp"]
@@ -76,34 +77,32 @@ def minimize_optuna_gp(
         asked), ``nrejected`` (infeasible trials, not simulated), ``nfailed`` (failed simulations).
     """
     optuna = require("optuna", "optuna_gp")
-    torch = require("torch", "optuna_gp", GP_PEERS_HINT)
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)  # the machine's cores are shared by the runs
+    require("torch", "optuna_gp", GP_PEERS_HINT)
     previous = _silenced(optuna)
     names = [f"x{i}" for i in range(problem.dim)]
     space = {n: optuna.distributions.FloatDistribution(float(lo), float(hi))
              for n, lo, hi in zip(names, problem.lower, problem.upper, strict=True)}
     counts = np.zeros(3, dtype=int)  # trials, rejected, failed
     message = "budget spent"
-    try:
-        with warnings.catch_warnings():
-            # GPSampler's deterministic_objective is flagged experimental: no reason to warn at every run.
-            warnings.simplefilter("ignore", optuna.exceptions.ExperimentalWarning)
-            sampler = optuna.samplers.GPSampler(seed=seed, n_startup_trials=n_startup_trials,
-                                                deterministic_objective=deterministic_objective)
-            study = optuna.create_study(direction="minimize", sampler=sampler)
-            while problem.remaining > 0:
-                trial = study.ask(space)
-                counts[0] += 1
-                x = np.array([trial.params[n] for n in names])
-                try:
-                    counts[1:] += _tell(optuna, study, trial, problem, x)
-                except BudgetExhausted:
-                    study.tell(trial, state=optuna.trial.TrialState.FAIL)
-                    raise
-    except BudgetExhausted as exc:
-        message = str(exc)
-    finally:
-        optuna.logging.set_verbosity(previous)
-        torch.set_num_threads(threads)
+    with one_torch_thread():  # the machine's cores are shared by the runs
+        try:
+            with warnings.catch_warnings():
+                # GPSampler's deterministic_objective is flagged experimental: no reason to warn at every run.
+                warnings.simplefilter("ignore", optuna.exceptions.ExperimentalWarning)
+                sampler = optuna.samplers.GPSampler(seed=seed, n_startup_trials=n_startup_trials,
+                                                    deterministic_objective=deterministic_objective)
+                study = optuna.create_study(direction="minimize", sampler=sampler)
+                while problem.remaining > 0:
+                    trial = study.ask(space)
+                    counts[0] += 1
+                    x = np.array([trial.params[n] for n in names])
+                    try:
+                        counts[1:] += _tell(optuna, study, trial, problem, x)
+                    except BudgetExhausted:
+                        study.tell(trial, state=optuna.trial.TrialState.FAIL)
+                        raise
+        except BudgetExhausted as exc:
+            message = str(exc)
+        finally:
+            optuna.logging.set_verbosity(previous)
     return problem.result(message, ntrials=int(counts[0]), nrejected=int(counts[1]), nfailed=int(counts[2]))
