@@ -124,6 +124,7 @@ def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--budgets", type=int, nargs="+", default=[50, 100])
     ap.add_argument("--seeds", type=int, default=10)
+    ap.add_argument("--first-seed", type=int, default=0, help="run seeds first-seed .. seeds - 1 (split a long run)")
     ap.add_argument("--problems", nargs="+", default=list(MIXED_SUITE), choices=list(MIXED_SUITE))
     ap.add_argument("--methods", nargs="+", default=[OWN_METHOD, *PEERS])
     ap.add_argument("--cap-model", type=int, default=None,
@@ -135,7 +136,7 @@ def main(argv: list[str] | None = None) -> None:
     done = [json.loads(line) for line in args.out.read_text().splitlines()] if args.out.is_file() else []
     have = {(r["problem"], r["method"], r["budget"], r["seed"]) for r in done}
     for budget in [] if args.table else args.budgets:
-        for seed in range(args.seeds):
+        for seed in range(args.first_seed, args.seeds):
             for name in args.problems:
                 dim = MIXED_SUITE[name]().dim
                 for method in args.methods:
