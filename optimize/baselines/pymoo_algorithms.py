@@ -41,7 +41,17 @@ from mechopt.optimize.baselines.library import require
 from mechopt.optimize.baselines.mixed_space import has_discrete
 from mechopt.optimize.budget import BudgetExhausted, CountedProblem
 
-__all__ = ["default_pop_size", "minimize_pymoo_de", "minimize_pymoo_ga", "minimize_pymoo_pso"]
+__all__ = ["default_pop_size", "objective_value", "minimize_pymoo_de", "minimize_pymoo_ga", "minimize_pymoo_pso"]
+
+
+def objective_value(problem: CountedProblem, x: np.ndarray) -> float:
+    """The value pymoo is told for design ``x``: simulated when feasible (a failed simulation at the infeasible
+    value), else the penalty, which counts the proposal but never simulates.  Raises BudgetExhausted when the
+    budget is spent."""
+    if problem.feasible(x)[0]:
+        f = problem.evaluate(x)
+        return f if math.isfinite(f) else problem.infeasible_value
+    return problem.penalised(x)
 
 
 def default_pop_size(budget: int) -> int:
@@ -76,11 +86,7 @@ def _pymoo_problem(problem: CountedProblem) -> Any:
                 box = np.sum(np.maximum(problem.lower - x, 0.0)) + np.sum(np.maximum(x - problem.upper, 0.0))
                 G[i, :n_margins] = -problem.margins(problem.clip(x))
                 G[i, n_margins] = box
-                if problem.feasible(x)[0]:
-                    f = problem.evaluate(x)  # raises BudgetExhausted when the budget is spent
-                    F[i, 0] = f if math.isfinite(f) else problem.infeasible_value
-                else:
-                    F[i, 0] = problem.penalised(x)  # counts the proposal, never simulates
+                F[i, 0] = objective_value(problem, x)
             out["F"] = F
             out["G"] = G
 

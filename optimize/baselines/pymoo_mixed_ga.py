@@ -14,7 +14,6 @@ given its stored value without a second simulation (pymoo only removes duplicate
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
@@ -22,7 +21,7 @@ from scipy.optimize import OptimizeResult
 
 from mechopt.optimize.baselines.library import require
 from mechopt.optimize.baselines.mixed_space import from_pymoo, pymoo_variables
-from mechopt.optimize.baselines.pymoo_algorithms import default_pop_size
+from mechopt.optimize.baselines.pymoo_algorithms import default_pop_size, objective_value
 from mechopt.optimize.budget import BudgetExhausted, CountedProblem
 
 __all__ = ["minimize_pymoo_mixed_ga"]
@@ -44,11 +43,7 @@ def _mixed_problem(problem: CountedProblem) -> Any:
                 x = from_pymoo(problem, values)
                 if problem.has_constraints:
                     G[i] = -problem.margins(x)
-                if problem.feasible(x)[0]:
-                    f = problem.evaluate(x)  # raises BudgetExhausted when the budget is spent
-                    F[i, 0] = f if math.isfinite(f) else problem.infeasible_value
-                else:
-                    F[i, 0] = problem.penalised(x)  # counts the proposal, never simulates
+                F[i, 0] = objective_value(problem, x)
             out["F"] = F
             out["G"] = G
 
