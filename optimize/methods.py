@@ -143,6 +143,13 @@ BAYESIAN_MAX_BUDGET = 200
 GP_PEER_MAX_BUDGET = 300
 
 
+#: The default method's options (read on trade-offs only: one objective has one acquisition).
+_AUTO_OPTIONS = (
+    Option("front", "ehvi", str, "acquisition on several objectives: 'ehvi' expected hypervolume improvement, "
+           "'parego' ParEGO's random scalarisations", values=("ehvi", "parego")),
+)
+
+
 def _own_records() -> list[Method]:
     """mechopt's own methods: they run on the sampler and propose batches of designs."""
     return [
@@ -150,7 +157,7 @@ def _own_records() -> list[Method]:
                "(Matern-5/2, expected improvement): one global model up to 300 designs, restarted trust regions "
                "beyond, or Gauss-Newton runs from multi-level single linkage starts when the problem declares "
                "residuals; failed simulations learned and avoided", own=True, dims=(1, None), batches=True,
-               min_budget=lambda dim, budget, n_lines: (auto_min_budget(dim), "2d + 2"), options=(),
+               min_budget=lambda dim, budget, n_lines: (auto_min_budget(dim), "2d + 2"), options=_AUTO_OPTIONS,
                starts_from_x0=True, compare_name="mechopt-auto", max_objectives=MAX_OBJECTIVES, discrete=True),
         Method("sparse", run_sparse, "paper 002's line model: lines sampled, fitted by sums of exponentials, blended "
                "by Chebyshev interpolation, searched exhaustively, refined on the simulator (smooth landscapes)",

@@ -257,7 +257,7 @@ def run_method(problem: DesignProblem, method: str | Callable[..., Any], opts: S
     if method == AUTO_METHOD and problem.trade_off:
         # Several objectives or limits on simulated outputs: x0 counts in the budget, as for the other plans.
         return run_trade_off(problem, int(opts.budget) + (0 if x0 is None else len(x0)), int(opts.seed), sampler,
-                             initial=x0)
+                             initial=x0, scalarise=dict(options or {}).get("front") == "parego")
     record = get_method(method)
     call = MethodCall(problem, opts, sampler, log, record.name, dict(options or {}))
     if x0 is None:

@@ -60,7 +60,7 @@ def _missing_output(problem: DesignProblem, records: list) -> None:
 
 
 def run_trade_off(problem: DesignProblem, budget: int, seed: int, sampler, initial: np.ndarray | None = None,
-                  desc: str = "auto") -> OptimizeResult:
+                  desc: str = "auto", scalarise: bool = False) -> OptimizeResult:
     """Run the default method on a trade-off problem within ``budget`` simulations.
 
     Parameters
@@ -77,6 +77,8 @@ def run_trade_off(problem: DesignProblem, budget: int, seed: int, sampler, initi
         Designs simulated first.
     desc : str
         Progress label.
+    scalarise : bool
+        Several objectives by ParEGO's scalarisations instead of the expected hypervolume improvement.
 
     Returns
     -------
@@ -109,11 +111,13 @@ def run_trade_off(problem: DesignProblem, budget: int, seed: int, sampler, initi
     try:
         run = trade_off_search(evaluate, problem.bounds, budget, spec.k, limits.lower, limits.upper, seed=seed,
                                feasible=problem.feasible, batch=sampler.batch_size,
-                               margins=margins if problem.constraints else None, initial=initial)
+                               margins=margins if problem.constraints else None, initial=initial,
+                               scalarise=scalarise)
     finally:
         sampler.watchers.remove(watch)
     answer = trade_off_answer(problem, run.X, run.F, run.G, run.ok, outputs)
-    kind = f"ParEGO on {spec.k} objectives" if spec.k > 1 else "constrained expected improvement"
+    acquisition = "ParEGO" if scalarise else "expected hypervolume improvement"
+    kind = f"{acquisition} on {spec.k} objectives" if spec.k > 1 else "constrained expected improvement"
     limited = f" under limits {limits.describe()}" if limits.m else ""
     answer["message"] = f"{kind}{limited}, {run.X.shape[0]} simulations: {answer['message']}"
     return OptimizeResult(**answer, nfev=len(sampler.designs), method="auto", plan="trade-off", model=None,

@@ -27,7 +27,9 @@ from scipy.stats import qmc
 from mechopt.optimize.auto.acquisition import propose_batch
 from mechopt.optimize.auto.feasibility import SuccessModel
 from mechopt.optimize.auto.gp import GaussianProcess, fit_gp
+from mechopt.optimize.auto.hypervolume_proposal import affordable, propose_by_hypervolume
 from mechopt.optimize.auto.limit_models import LimitModels
+from mechopt.optimize.auto.output_models import OutputModels
 from mechopt.optimize.auto.search import _limited_threads
 
 __all__ = ["TradeOffRun", "initial_size", "trade_off_search"]
@@ -190,10 +192,38 @@ def _propose(state: _State, limits: LimitModels, model: _Scalarised, q: int, rng
     return chosen
 
 
+def _front_affordable(state: _State, limits: LimitModels) -> bool:
+    """Whether the expected hypervolume improvement's boxes of the current front are few enough."""
+    G = state.G[state.ok]
+    return affordable(state.F[state.ok], np.all((G >= limits.lower) & (G <= limits.upper), axis=1))
+
+
+def _propose_front(state: _State, limits: LimitModels, objectives: OutputModels, q: int, rng: np.random.Generator,
+                   margins: Callable[[np.ndarray], np.ndarray] | None) -> np.ndarray:
+    """``q`` designs by expected hypervolume improvement (:mod:`~mechopt.optimize.auto.hypervolume_proposal`)."""
+    ok = state.ok
+    U, F, G = state.U[ok], state.F[ok], state.G[ok]
+    met = np.all((G >= limits.lower) & (G <= limits.upper), axis=1)
+    if limits.m:
+        limits.fit(U, G, rng)
+    objectives.fit(U, F, rng)
+    d = U.shape[1]
+    # Failures are learned with the first objective's length-scales, as the single-objective search does.
+    success = None if ok.all() else SuccessModel(state.U, ok, objectives.models[0][0].theta[:d])
+
+    def log_feasible(C: np.ndarray) -> np.ndarray:
+        total = limits.log_probability(C)
+        return total + success.log_probability(C) if success is not None else total
+
+    use_lf = limits.m > 0 or success is not None
+    return propose_by_hypervolume(U, F, met, objectives, q, rng, state.allowed, log_feasible if use_lf else None,
+                                  margins)
+
+
 def trade_off_search(evaluate: TradeOffEvaluator, bounds: np.ndarray, budget: int, k: int, lower: np.ndarray,
                      upper: np.ndarray, seed: int = 0, feasible: Callable[[np.ndarray], np.ndarray] | None = None,
                      batch: int = 1, margins: Callable[[np.ndarray], np.ndarray] | None = None,
-                     initial: np.ndarray | None = None) -> TradeOffRun:
+                     initial: np.ndarray | None = None, scalarise: bool = False) -> TradeOffRun:
     """Spend ``budget`` simulations on a Pareto front (k > 1) or on the best design meeting the limits (k = 1).
 
     Parameters
@@ -218,6 +248,9 @@ def trade_off_search(evaluate: TradeOffEvaluator, bounds: np.ndarray, budget: in
         ``margins(X) -> (n, c)`` of the declared constraints: proposals may end on one.
     initial : (p, d) ndarray, optional
         Designs to simulate first, inside the bounds (they count in the budget).
+    scalarise : bool
+        Several objectives by ParEGO's random scalarisations throughout, instead of the expected hypervolume
+        improvement (which the search leaves for ParEGO only when the front outgrows its box decomposition).
 
     Returns
     -------
@@ -233,11 +266,13 @@ def trade_off_search(evaluate: TradeOffEvaluator, bounds: np.ndarray, budget: in
         if initial is not None and len(initial):
             state.simulate((np.atleast_2d(np.asarray(initial, float)) - state.lo) / state.width)
         state.simulate(_space_filling(state, max(0, initial_size(d, int(budget)) - state.U.shape[0]), rng))
-        model = _Scalarised()
+        model, objectives = _Scalarised(), OutputModels(k)
         while state.remaining > 0:
             q = min(max(1, int(batch)), state.remaining)
             if state.ok.sum() < 2:
                 U = _space_filling(state, q, rng)
+            elif k > 1 and scalarise is False and _front_affordable(state, limits):
+                U = _propose_front(state, limits, objectives, q, rng, unit_margins)
             else:
                 U = _propose(state, limits, model, q, rng, unit_margins)
             if not U.shape[0]:

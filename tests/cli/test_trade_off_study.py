@@ -50,7 +50,7 @@ def test_ventilator_front_from_the_command_line(tmp_path):
     proc = mechopt("study", "ventilator", *RUN, "--objective", "t_rms,-toggle_margin_deg", "--budget", "14",
                    "--out", str(out))
     assert proc.returncode == 0, proc.stderr
-    assert "ParEGO on 2 objectives" in proc.stdout
+    assert "expected hypervolume improvement on 2 objectives" in proc.stdout
     for name in ("report.md", "front.csv", "result.json", "figures/front.png", "figures/progress.png"):
         assert (out / name).is_file(), name
     rows = list(csv.reader((out / "front.csv").open()))

@@ -54,7 +54,7 @@ def test_an_unknown_option_is_refused_in_one_line_naming_the_methods_options():
     text = str(info.value)
     assert "\n" not in text
     assert "unknown option 'n_start' of method 'slsqp'; expected one of n_starts, fd_step, ftol, maxiter" in text
-    with pytest.raises(InputError, match="unknown option 'n_lines' of method 'auto'; it takes none"):
+    with pytest.raises(InputError, match="unknown option 'n_lines' of method 'auto'; expected one of front"):
         mechopt.minimize(Branin(), budget=20, method="auto", options={"n_lines": 3})
     with pytest.raises(InputError, match="n_starts = 'two': expected int"):
         check_options("slsqp", {"n_starts": "two"})

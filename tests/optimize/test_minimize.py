@@ -110,7 +110,7 @@ def test_baselines_run_through_the_same_entry_point(method):
     ({"workers": 0}, "workers = 0"),
     ({"method": "sparse", "options": {"n_lines": "seven"}}, "n_lines = 'seven'"),
     ({"method": "sparse", "options": {"lines": 7}}, "unknown option lines"),
-    ({"options": {"n_lines": 7}}, "unknown option 'n_lines' of method 'auto'; it takes none"),
+    ({"options": {"n_lines": 7}}, "unknown option 'n_lines' of method 'auto'; expected one of front"),
     ({"method": "slsqp", "options": {"n_starts": 1.5}}, "method 'slsqp': n_starts = 1.5: expected int"),
     ({"store": 123}, "store = 123"),
     ({"method": "sparse", "budget": 6}, "needs at least 2 samples on each of its 3 lines + 1 = 7"),
