@@ -4,9 +4,10 @@
 The front is that of the designs that met every limit; its objectives are mapped to z = (f − ideal) / (nadir −
 ideal) and the reference point is z = 1.1, the normalisation mechopt reports (:mod:`~mechopt.optimize.pareto`).
 A reference at the front's own nadir gives no credit for moving past the front's ends, where the true front may go
-on (ZDT3's first piece, ZDT1's ends); so with two objectives every other proposal takes the reference beyond the
-worst feasible design simulated instead, as Optuna's GPSampler does for all of them.  With three objectives the
-extending half was measured too and is not kept (the measurements: ``docs/guide/trade_offs.md``).
+on (ZDT3's first piece, ZDT1's ends); so one proposal in k (k objectives) takes the reference beyond the worst
+feasible design simulated instead, as Optuna's GPSampler does for all of them.  With two objectives, the candidates
+also move only some variables of a front design (as the trust regions' candidates do), which pays there and not
+with three (the measurements of both choices: ``docs/guide/trade_offs.md``).
 The acquisition is log EHVI + log P(every limit met) + log P(success).  A batch of W workers is chosen one design at
 a time, each with the previous ones believed at their posterior mean and added to the front, so that the next one
 looks for hypervolume elsewhere (the kriging believer of the single-objective batches).
@@ -28,6 +29,12 @@ __all__ = ["MOST_BOXES", "affordable", "propose_by_hypervolume"]
 #: Largest box decomposition the proposal computes (a front of 140 points in three objectives, of 21 in four);
 #: beyond it the trade-off search scalarises (ParEGO), whose cost does not grow with the front.
 MOST_BOXES = 20_000
+
+#: Most objectives for which the candidates include front designs with only some variables moved.
+SPARSE_UP_TO = 2
+
+#: One proposal in k (the number of objectives) takes the reference beyond the worst feasible design.
+EXTEND_EVERY = {2: 2, 3: 3, 4: 4}
 
 
 def _front_scale(F: np.ndarray, met: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -79,8 +86,9 @@ def propose_by_hypervolume(U: np.ndarray, F: np.ndarray, met: np.ndarray, object
     front, ideal, span = _front_scale(F, met)
     Z = (front - ideal) / span
     reference = np.full(F.shape[1], REFERENCE_MARGIN)
-    # Every other proposal of two objectives extends the front: its reference lies beyond the worst feasible design.
-    extended = reference if F.shape[1] != 2 or not met.any() else \
+    # One proposal in k extends the front: its reference lies beyond the worst feasible design.
+    period = EXTEND_EVERY.get(F.shape[1], 0)
+    extended = reference if not period or not met.any() else \
         np.maximum(reference, ((F[met] - ideal) / span).max(axis=0) + REFERENCE_MARGIN - 1.0)
     d = U.shape[1]
     lo, hi = np.zeros(d), np.ones(d)
@@ -88,7 +96,8 @@ def propose_by_hypervolume(U: np.ndarray, F: np.ndarray, met: np.ndarray, object
     chosen: list[np.ndarray] = []
     has_front = Z.shape[0] > 0
     for i in range(q):
-        boxes = BoxDecomposition.of(Z, extended if (U.shape[0] + i) % 2 else reference)
+        extend = period > 0 and (U.shape[0] + i) % period == period - 1
+        boxes = BoxDecomposition.of(Z, extended if extend else reference)
 
         def score(C: np.ndarray, boxes: BoxDecomposition = boxes) -> np.ndarray:
             # Until a design meets the limits there is no front: the probability of meeting them chooses.
@@ -105,7 +114,8 @@ def propose_by_hypervolume(U: np.ndarray, F: np.ndarray, met: np.ndarray, object
             return ok
 
         centre = front_designs[rng.integers(front_designs.shape[0])]
-        x = _maximise(score, lo, hi, _candidates(lo, hi, centre, 1024, rng), fresh, 3, margins)
+        C = _candidates(lo, hi, centre, 1024, rng, sparse=F.shape[1] <= SPARSE_UP_TO)
+        x = _maximise(score, lo, hi, C, fresh, 3, margins)
         if x is None:
             break
         chosen.append(x)

@@ -1,4 +1,5 @@
-"""Several objectives and limits on simulated outputs through mechopt.minimize (ParEGO, constrained EI)."""
+"""Several objectives and limits on simulated outputs through mechopt.minimize (expected hypervolume improvement or
+ParEGO, constrained EI)."""
 
 from __future__ import annotations
 
@@ -70,7 +71,7 @@ def test_two_objective_front_is_sorted_non_dominated_with_its_hypervolume():
     assert res.hypervolume_trace[-1] == pytest.approx(res.hypervolume)
     assert np.all(np.diff(res.hypervolume_trace) >= -1e-12)
     assert [o["f1"] for o in res.front_outputs] == pytest.approx(res.fun[:, 0])
-    # ParEGO finds the true front's shape: f2 within 0.15 of 1 - sqrt(f1) for the front's designs at 30 simulations.
+    # The search finds the true front's shape: f2 within 0.15 of 1 - sqrt(f1) for the front's designs at 30 simulations.
     assert np.median(res.fun[:, 1] - (1.0 - np.sqrt(res.fun[:, 0]))) < 0.15
 
 
@@ -125,3 +126,41 @@ def test_parse_limit():
     for bad in ("t_rms<3", "3<=4", "t_rms<=x"):
         with pytest.raises(InputError, match="expected 'name<=value'"):
             parse_limit(bad)
+
+
+def test_the_front_by_parego_on_request_and_by_hypervolume_by_default():
+    ehvi = mechopt.minimize(Zdt1(), budget=30, seed=0)
+    parego = mechopt.minimize(Zdt1(), budget=30, seed=0, options={"front": "parego"})
+    assert "expected hypervolume improvement on 2 objectives" in ehvi.message
+    assert "ParEGO on 2 objectives" in parego.message
+    assert np.median(parego.fun[:, 1] - (1.0 - np.sqrt(parego.fun[:, 0]))) < 0.15
+
+
+def test_an_unknown_front_acquisition_is_refused_in_one_line():
+    with pytest.raises(InputError, match="front = 'nsga'; expected one of ehvi, parego"):
+        mechopt.minimize(Zdt1(), budget=30, options={"front": "nsga"})
+
+
+def _dtlz2_3(X):
+    X = np.atleast_2d(X)
+    g = np.sum((X[:, 2:] - 0.5) ** 2, axis=1)
+    a, b = X[:, 0] * np.pi / 2, X[:, 1] * np.pi / 2
+    return np.column_stack([np.cos(a) * np.cos(b), np.cos(a) * np.sin(b), np.sin(a)]) * (1 + g)[:, None]
+
+
+def test_three_objectives_in_batches_beat_as_many_space_filling_designs():
+    from scipy.stats import qmc
+
+    from mechopt.optimize.auto.multi_objective import trade_off_search
+
+    def evaluate(X):
+        return _dtlz2_3(X), np.zeros((len(X), 0)), np.ones(len(X), dtype=bool)
+
+    run = trade_off_search(evaluate, np.array([[0.0, 1.0]] * 4), 40, 3, np.zeros(0), np.zeros(0), seed=3, batch=3)
+    assert run.X.shape == (40, 4) and len({tuple(x) for x in run.X}) == 40
+    sobol = _dtlz2_3(qmc.Sobol(4, seed=3).random_base2(6)[:40])
+
+    def hv(F):
+        return moocore.hypervolume(F[moocore.is_nondominated(F)], ref=[1.1, 1.1, 1.1])
+
+    assert hv(run.F) > 1.1 * hv(sobol)
