@@ -1,19 +1,21 @@
-"""The default method on trade-offs: several objectives (ParEGO) and limits on simulated outputs (constrained EI).
+"""The default method on trade-offs: several objectives (expected hypervolume improvement, or ParEGO) and limits on
+simulated outputs (constrained EI).
 
-Several objectives are handled by ParEGO (Knowles 2006): each proposal draws a weight vector λ uniformly from the
-simplex, scalarises the normalised objectives of every simulated design by the augmented Chebyshev function
-s = max_j λ_j z_j + ρ Σ_j λ_j z_j (ρ = 0.05; z_j the objective mapped to [0, 1] over the designs simulated),
-fits the default method's Gaussian process to s and maximises its expected improvement.  Every non-dominated design
-minimises s for some λ, so the random weights spread the proposals along the front; a batch of W workers takes W
-weights, one design each.  ParEGO needs one GP fit per design, which keeps the method's own time within a fraction
-of a second per simulation at 200 designs and 3 objectives; expected hypervolume improvement needs the joint model
-of the objectives and an integral over the non-dominated cells, which grows fast with the front in 3 objectives.
+Several objectives are handled by the expected hypervolume improvement of
+:mod:`~mechopt.optimize.auto.hypervolume_proposal`: one GP per objective, the closed-form EHVI of the current
+feasible front, batches of W workers by believed fronts.  ParEGO (Knowles 2006) is the alternative
+(``scalarise=True``, the option ``front="parego"``), and the fallback when the front's box decomposition would grow
+past :data:`~mechopt.optimize.auto.hypervolume_proposal.MOST_BOXES` (four objectives and a large front): each
+proposal draws a weight vector λ uniformly from the simplex, scalarises the normalised objectives of every simulated
+design by the augmented Chebyshev function s = max_j λ_j z_j + ρ Σ_j λ_j z_j (ρ = 0.05; z_j the objective mapped to
+[0, 1] over the designs simulated), fits the default method's Gaussian process to s and maximises its expected
+improvement; a batch of W workers takes W weights.
 
 Limits on simulated outputs: each limited output has its own GP (:mod:`~mechopt.optimize.auto.limit_models`) and
-the acquisition is log EI + log P(every limit met) (constrained EI); the incumbent is the best design that met the
-limits, and until one has, the search maximises the probability of meeting them.  One objective with limits is the
-same loop with λ = (1).  Failed simulations are learned as in :func:`~mechopt.optimize.auto.search.auto_search`
-(:class:`~mechopt.optimize.auto.feasibility.SuccessModel`).
+the acquisition is log EI (or log EHVI) + log P(every limit met) (constrained EI); the incumbent is the best design
+that met the limits, and until one has, the search maximises the probability of meeting them.  One objective with
+limits is the ParEGO loop with λ = (1).  Failed simulations are learned as in
+:func:`~mechopt.optimize.auto.search.auto_search` (:class:`~mechopt.optimize.auto.feasibility.SuccessModel`).
 """
 
 from __future__ import annotations
