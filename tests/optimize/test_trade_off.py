@@ -164,15 +164,3 @@ def test_three_objectives_in_batches_beat_as_many_space_filling_designs():
         return moocore.hypervolume(F[moocore.is_nondominated(F)], ref=[1.1, 1.1, 1.1])
 
     assert hv(run.F) > 1.1 * hv(sobol)
-
-
-def test_a_declared_normalisation_is_the_one_the_search_measures_against():
-    from mechopt.optimize.trade_off import _declared_scale
-
-    assert _declared_scale(Zdt1()) is None
-    declared = _variant(Zdt1, ideal=np.zeros(2), nadir=np.ones(2))
-    ideal, nadir = _declared_scale(declared)
-    assert np.array_equal(ideal, [0.0, 0.0]) and np.array_equal(nadir, [1.0, 1.0])
-    res = mechopt.minimize(declared, budget=24, seed=0)
-    assert "problem's ideal" in res.normalisation
-    assert np.median(res.fun[:, 1] - (1.0 - np.sqrt(res.fun[:, 0]))) < 0.3
