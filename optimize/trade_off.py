@@ -59,15 +59,6 @@ def _missing_output(problem: DesignProblem, records: list) -> None:
                                  f"among its outputs ({r.error})")
 
 
-def _declared_scale(problem: DesignProblem) -> tuple[np.ndarray, np.ndarray] | None:
-    """The problem's ``ideal`` and ``nadir`` of its minimised objectives, when it declares both (the normalisation of
-    the hypervolume its answer reports, :func:`~mechopt.optimize.pareto.normalisation`)."""
-    ideal, nadir = getattr(problem, "ideal", None), getattr(problem, "nadir", None)
-    if ideal is None or nadir is None or problem.objective_spec.k < 2:
-        return None
-    return np.asarray(ideal, float), np.asarray(nadir, float)
-
-
 def run_trade_off(problem: DesignProblem, budget: int, seed: int, sampler, initial: np.ndarray | None = None,
                   desc: str = "auto", scalarise: bool = False) -> OptimizeResult:
     """Run the default method on a trade-off problem within ``budget`` simulations.
@@ -121,7 +112,7 @@ def run_trade_off(problem: DesignProblem, budget: int, seed: int, sampler, initi
         run = trade_off_search(evaluate, problem.bounds, budget, spec.k, limits.lower, limits.upper, seed=seed,
                                feasible=problem.feasible, batch=sampler.batch_size,
                                margins=margins if problem.constraints else None, initial=initial,
-                               scalarise=scalarise, scale=_declared_scale(problem))
+                               scalarise=scalarise)
     finally:
         sampler.watchers.remove(watch)
     answer = trade_off_answer(problem, run.X, run.F, run.G, run.ok, outputs)

@@ -36,8 +36,6 @@ SPARSE_UP_TO = 2
 #: One proposal in k (the number of objectives) takes the reference beyond the worst feasible design.
 EXTEND_EVERY = {2: 2, 3: 3, 4: 4}
 
-USE_SCALE = True
-
 
 def _front_scale(F: np.ndarray, met: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Front (p, k) of the designs meeting the limits, and the ideal and span that map it to [0, 1]."""
@@ -57,8 +55,7 @@ def affordable(F: np.ndarray, met: np.ndarray) -> bool:
 def propose_by_hypervolume(U: np.ndarray, F: np.ndarray, met: np.ndarray, objectives: OutputModels, q: int,
                            rng: np.random.Generator, allowed: Callable[[np.ndarray], np.ndarray],
                            log_feasible: Callable[[np.ndarray], np.ndarray] | None,
-                           margins: Callable[[np.ndarray], np.ndarray] | None = None,
-                           scale: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+                           margins: Callable[[np.ndarray], np.ndarray] | None = None) -> np.ndarray:
     """``q`` designs of the unit cube maximising log EHVI (+ log P(limits met, success)).
 
     Parameters
@@ -80,8 +77,6 @@ def propose_by_hypervolume(U: np.ndarray, F: np.ndarray, met: np.ndarray, object
         Log-probability of meeting the limits and of a successful simulation.
     margins : callable, optional
         Declared constraints' margins in the unit cube (the polish may end on one).
-    scale : (ideal (k,), nadir (k,)), optional
-        The problem's normalisation: z = (f − ideal) / (nadir − ideal), reference z = 1.1 for every proposal.
 
     Returns
     -------
@@ -89,13 +84,10 @@ def propose_by_hypervolume(U: np.ndarray, F: np.ndarray, met: np.ndarray, object
         p <= q designs (fewer when no allowed candidate is left).
     """
     front, ideal, span = _front_scale(F, met)
-    scale = scale if USE_SCALE else None
-    if scale is not None:
-        ideal, span = np.asarray(scale[0], float), np.maximum(np.asarray(scale[1], float) - scale[0], 1e-300)
     Z = (front - ideal) / span
     reference = np.full(F.shape[1], REFERENCE_MARGIN)
     # One proposal in k extends the front: its reference lies beyond the worst feasible design.
-    period = 0 if scale is not None else EXTEND_EVERY.get(F.shape[1], 0)
+    period = EXTEND_EVERY.get(F.shape[1], 0)
     extended = reference if not period or not met.any() else \
         np.maximum(reference, ((F[met] - ideal) / span).max(axis=0) + REFERENCE_MARGIN - 1.0)
     d = U.shape[1]

@@ -201,8 +201,7 @@ def _front_affordable(state: _State, limits: LimitModels) -> bool:
 
 
 def _propose_front(state: _State, limits: LimitModels, objectives: OutputModels, q: int, rng: np.random.Generator,
-                   margins: Callable[[np.ndarray], np.ndarray] | None,
-                   scale: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+                   margins: Callable[[np.ndarray], np.ndarray] | None) -> np.ndarray:
     """``q`` designs by expected hypervolume improvement (:mod:`~mechopt.optimize.auto.hypervolume_proposal`)."""
     ok = state.ok
     U, F, G = state.U[ok], state.F[ok], state.G[ok]
@@ -220,14 +219,13 @@ def _propose_front(state: _State, limits: LimitModels, objectives: OutputModels,
 
     use_lf = limits.m > 0 or success is not None
     return propose_by_hypervolume(U, F, met, objectives, q, rng, state.allowed, log_feasible if use_lf else None,
-                                  margins, scale)
+                                  margins)
 
 
 def trade_off_search(evaluate: TradeOffEvaluator, bounds: np.ndarray, budget: int, k: int, lower: np.ndarray,
                      upper: np.ndarray, seed: int = 0, feasible: Callable[[np.ndarray], np.ndarray] | None = None,
                      batch: int = 1, margins: Callable[[np.ndarray], np.ndarray] | None = None,
-                     initial: np.ndarray | None = None, scalarise: bool = False,
-                     scale: tuple[np.ndarray, np.ndarray] | None = None) -> TradeOffRun:
+                     initial: np.ndarray | None = None, scalarise: bool = False) -> TradeOffRun:
     """Spend ``budget`` simulations on a Pareto front (k > 1) or on the best design meeting the limits (k = 1).
 
     Parameters
@@ -255,9 +253,6 @@ def trade_off_search(evaluate: TradeOffEvaluator, bounds: np.ndarray, budget: in
     scalarise : bool
         Several objectives by ParEGO's random scalarisations throughout, instead of the expected hypervolume
         improvement (which the search leaves for ParEGO only when the front outgrows its box decomposition).
-    scale : (ideal (k,), nadir (k,)), optional
-        The problem's own normalisation of the minimised objectives: the expected hypervolume improvement is then
-        measured against its reference point (the hypervolume the answer reports), not the current front's.
 
     Returns
     -------
@@ -279,7 +274,7 @@ def trade_off_search(evaluate: TradeOffEvaluator, bounds: np.ndarray, budget: in
             if state.ok.sum() < 2:
                 U = _space_filling(state, q, rng)
             elif k > 1 and scalarise is False and _front_affordable(state, limits):
-                U = _propose_front(state, limits, objectives, q, rng, unit_margins, scale)
+                U = _propose_front(state, limits, objectives, q, rng, unit_margins)
             else:
                 U = _propose(state, limits, model, q, rng, unit_margins)
             if not U.shape[0]:
