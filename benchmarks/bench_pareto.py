@@ -1,5 +1,5 @@
-"""The default method (``method="auto"``: ParEGO / constrained EI) against the multi-objective peers on the suite of
-``studies/multi_objective_functions.py``, side by side at equal budgets.
+"""The default method (``method="auto"``: expected hypervolume improvement / constrained EI) against the
+multi-objective peers on the suite of ``studies/multi_objective_functions.py``, side by side at equal budgets.
 
 Score: the hypervolume of the feasible non-dominated designs a run evaluated, each objective normalised to
 z = (f − ideal) / (nadir − ideal) with the ideal and nadir of the problem's true front, reference point z = 1.1 in
