@@ -13,7 +13,11 @@ import math
 import sys
 import threading
 import time
+from collections.abc import Callable
 from typing import TextIO
+
+import moocore
+import numpy as np
 
 from mechopt.runs.store import SampleRecord
 
@@ -46,20 +50,27 @@ class ProgressLog:
     ----------
     planned : int
         Simulations the run plans (its budget, plus validation where there is one).
-    objective : str
-        Name of the output minimised (its best value is reported).
+    objective : str or tuple of str
+        Name of the output minimised (its best value is reported), or the objectives of a trade-off.
     stream : file, optional
         Where lines go (default ``sys.stderr``).
     interval_s : float, optional
         Longest silence, s (default 30).
     label : str, optional
         Prefix of every line.
+    score : callable, optional
+        ``score(record) -> (k,) ndarray or None``: a trade-off's minimised objectives of a design that meets every
+        limit (None otherwise).  Given, the line reports the best of one objective, or the size of the front of
+        several, over those designs only.
     """
 
-    def __init__(self, planned: int, objective: str, stream: TextIO | None = None, interval_s: float = 30.0,
-                 label: str = "progress") -> None:
+    def __init__(self, planned: int, objective: str | tuple[str, ...], stream: TextIO | None = None,
+                 interval_s: float = 30.0, label: str = "progress",
+                 score: Callable[[SampleRecord], np.ndarray | None] | None = None) -> None:
         self.planned = max(1, int(planned))
-        self.objective = objective
+        self.objective = objective if isinstance(objective, str) else ", ".join(objective)
+        self.score = score
+        self._points: list[np.ndarray] = []
         self.stream = stream
         self.interval_s = float(interval_s)
         self.label = label
@@ -85,6 +96,11 @@ class ProgressLog:
                     self._first_new = now - (record.wall_time_s or 0.0)
             if record.status == "failed":
                 self.failed += 1
+            elif record.ok and self.score is not None:
+                point = self.score(record)
+                if point is not None:
+                    self._points.append(point)
+                    self.best = min(self.best, float(point[0]))
             elif record.ok:
                 value = record.value(self.objective)
                 if math.isfinite(value):
@@ -97,7 +113,12 @@ class ProgressLog:
     def line(self) -> str:
         """The progress line as of now."""
         now = time.monotonic()
-        best = f"{self.best:.6g}" if math.isfinite(self.best) else "none yet"
+        best = f"best {self.objective} " + (f"{self.best:.6g}" if math.isfinite(self.best) else "none yet")
+        if self.score is not None and self._points and self._points[0].size > 1:
+            front = int(np.sum(moocore.is_nondominated(np.array(self._points))))
+            best = f"front of {front} designs ({self.objective})"
+        elif self.score is not None and not self._points:
+            best = f"no design meeting the limits yet ({self.objective})"
         left = max(0, self.planned - self.done)
         if left == 0:
             eta = "no simulation left"
@@ -106,7 +127,7 @@ class ProgressLog:
         else:
             eta = "time left not known yet"
         return (f"{self.label}: {self.done}/{self.planned} simulations ({100 * self.done / self.planned:.0f} %), "
-                f"best {self.objective} {best}, {self.failed} failed, {duration(now - self._start)} elapsed, {eta}")
+                f"{best}, {self.failed} failed, {duration(now - self._start)} elapsed, {eta}")
 
     def write(self, unless_written: bool = False) -> None:
         """Write the progress line now (with ``unless_written``, only if a design arrived since the last line)."""

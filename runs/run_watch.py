@@ -10,10 +10,30 @@ import contextlib
 from collections.abc import Iterator
 from typing import Any
 
+import numpy as np
+
 from mechopt.runs.early_stop import EarlyStop
 from mechopt.runs.progress_log import ProgressLog, wants_log_lines
 
 __all__ = ["watch_run"]
+
+
+def _trade_off_score(problem: Any) -> Any:
+    """A trade-off's minimised objectives of a record that meets every limit (None otherwise); None for a problem
+    of one objective and no limits on simulated outputs."""
+    if not getattr(problem, "trade_off", False):
+        return None
+    spec, limits = problem.objective_spec, problem.limit_spec
+
+    def score(record: Any) -> np.ndarray | None:
+        f = spec.values(record.outputs)
+        if not np.all(np.isfinite(f)):
+            return None
+        if limits.m and not limits.met(limits.values(record.outputs)[None, :])[0]:
+            return None
+        return f
+
+    return score
 
 
 @contextlib.contextmanager
@@ -41,7 +61,9 @@ def watch_run(sampler: Any, planned: int, *, progress: bool, stop_after_failures
         The progress log when lines are written, else None.
     """
     watchers: list[Any] = [EarlyStop(stop_after_failures, retry_hint)] if stop_after_failures else []
-    log = ProgressLog(planned, sampler.problem.objective) if progress and wants_log_lines() else None
+    problem = sampler.problem
+    log = ProgressLog(planned, problem.objective, score=_trade_off_score(problem)) \
+        if progress and wants_log_lines() else None
     if log is not None:
         watchers.append(log)
     sampler.watchers.extend(watchers)

@@ -36,6 +36,26 @@ def test_a_line_at_each_tenth_with_the_best_so_far_and_the_failures():
     assert lines[-1].endswith("no simulation left")
 
 
+def test_a_trade_off_reports_its_front_over_the_designs_that_meet_the_limits():
+    import numpy as np
+
+    def score(r: SampleRecord):  # (f, g) minimised; a design meets the limit when g <= 1
+        return np.array([r.outputs["f"], r.outputs["g"]]) if r.outputs["h"] <= 1.0 else None
+
+    stream = io.StringIO()
+    log = ProgressLog(4, ("f", "g"), stream=stream, interval_s=3600.0, score=score)
+    points = [(0.0, 2.0, 5.0), (1.0, 1.0, 0.0), (2.0, 0.0, 0.0), (3.0, 3.0, 0.0)]  # the first breaks the limit
+    try:
+        for i, (f, g, h) in enumerate(points):
+            log.record(SampleRecord(design=(float(i),), fingerprint="fp", status="ok",
+                                    outputs={"f": f, "g": g, "h": h}, wall_time_s=0.01))
+            if i == 0:
+                assert "no design meeting the limits yet (f, g)" in log.line()
+    finally:
+        log.close()
+    assert "front of 2 designs (f, g)" in stream.getvalue().splitlines()[-1]
+
+
 def test_a_line_at_least_every_interval_while_nothing_arrives():
     stream = io.StringIO()
     log = ProgressLog(1000, "f", stream=stream, interval_s=0.2)
