@@ -20,7 +20,7 @@ from mechopt.optimize.auto.design_grid import ENUMERATE_MAX, DesignGrid
 from mechopt.optimize.auto.gp import GaussianProcess
 from mechopt.optimize.auto.held_polish import polished_neighbours
 
-__all__ = ["log_expected_improvement", "propose_batch", "thompson_batch"]
+__all__ = ["log_expected_improvement", "not_chosen", "propose_batch", "thompson_batch"]
 
 _LOG_SQRT_2PI = 0.5 * math.log(2.0 * math.pi)
 #: Margin kept from a declared constraint by the constrained polish (the margins' units: mm, degrees).
@@ -143,6 +143,20 @@ def _allowed_near(score: Callable[[np.ndarray], np.ndarray], grid: DesignGrid, X
     return N[i], float(s[i])
 
 
+def not_chosen(allowed: Callable[[np.ndarray], np.ndarray],
+               chosen: list[np.ndarray]) -> Callable[[np.ndarray], np.ndarray]:
+    """``allowed`` narrowed to designs farther than 1e-6 (max norm, unit cube) from every design of ``chosen``: the
+    batch chosen so far (the list is read at each call, so designs appended later count)."""
+
+    def fresh(U: np.ndarray) -> np.ndarray:
+        ok = allowed(U)
+        for x in chosen:
+            ok &= np.max(np.abs(U - x), axis=1) > 1e-6
+        return ok
+
+    return fresh
+
+
 def propose_batch(gp: GaussianProcess, best: float, lo: np.ndarray, hi: np.ndarray, centre: np.ndarray, q: int,
                   rng: np.random.Generator, allowed: Callable[[np.ndarray], np.ndarray],
                   log_feasible: LogFeasible | None = None, n_candidates: int = 1024,
@@ -205,12 +219,7 @@ def propose_batch(gp: GaussianProcess, best: float, lo: np.ndarray, hi: np.ndarr
                 s = kappa * sd - mean
             return s + log_feasible(U) if log_feasible is not None else s
 
-        def fresh(U: np.ndarray) -> np.ndarray:
-            ok = allowed(U)
-            for x in chosen:
-                ok &= np.max(np.abs(U - x), axis=1) > 1e-6
-            return ok
-
+        fresh = not_chosen(allowed, chosen)
         C = _candidates(lo, hi, centre, n_candidates, rng, sparse)
         x = _maximise(score, lo, hi, C if grid is None else grid.candidates(C, lo, hi, centre), fresh, polish,
                       margins, grid)

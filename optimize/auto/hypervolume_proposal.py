@@ -19,7 +19,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from mechopt.optimize.auto.acquisition import _candidates, _maximise
+from mechopt.optimize.auto.acquisition import _candidates, _maximise, not_chosen
 from mechopt.optimize.auto.hypervolume_improvement import BoxDecomposition, expected_improvement
 from mechopt.optimize.auto.output_models import OutputModels
 from mechopt.optimize.pareto import REFERENCE_MARGIN, front_mask
@@ -107,15 +107,9 @@ def propose_by_hypervolume(U: np.ndarray, F: np.ndarray, met: np.ndarray, object
                 s = np.log(np.maximum(expected_improvement(boxes, (mean - ideal) / span, sd / span), 1e-300))
             return s + log_feasible(C) if log_feasible is not None else s
 
-        def fresh(C: np.ndarray) -> np.ndarray:
-            ok = allowed(C)
-            for x in chosen:
-                ok &= np.max(np.abs(C - x), axis=1) > 1e-6
-            return ok
-
         centre = front_designs[rng.integers(front_designs.shape[0])]
         C = _candidates(lo, hi, centre, 1024, rng, sparse=F.shape[1] <= SPARSE_UP_TO)
-        x = _maximise(score, lo, hi, C, fresh, 3, margins)
+        x = _maximise(score, lo, hi, C, not_chosen(allowed, chosen), 3, margins)
         if x is None:
             break
         chosen.append(x)

@@ -39,6 +39,10 @@ class LimitModels:
         """Number of limited outputs."""
         return self.lower.size
 
+    def met(self, G: np.ndarray) -> np.ndarray:
+        """Designs (n,) whose limited outputs G (n, m) lie within every limit."""
+        return np.all((G >= self.lower) & (G <= self.upper), axis=1)
+
     def fit(self, U: np.ndarray, G: np.ndarray, rng: np.random.Generator) -> None:
         """Fit each output's GP to designs U (n, d, unit cube) and their outputs G (n, m), all finite."""
         self._outputs.fit(U, G, rng)

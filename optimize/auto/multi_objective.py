@@ -157,7 +157,7 @@ def _propose(state: _State, limits: LimitModels, model: _Scalarised, q: int, rng
     U, F = state.U[ok], state.F[ok]
     lo, span = F.min(axis=0), np.ptp(F, axis=0)
     Z = (F - lo) / np.where(span > 0, span, 1.0)
-    met = np.all((state.G[ok] >= limits.lower) & (state.G[ok] <= limits.upper), axis=1)
+    met = limits.met(state.G[ok])
     if limits.m:
         limits.fit(U, state.G[ok], rng)
 
@@ -197,7 +197,7 @@ def _propose(state: _State, limits: LimitModels, model: _Scalarised, q: int, rng
 def _front_affordable(state: _State, limits: LimitModels) -> bool:
     """Whether the expected hypervolume improvement's boxes of the current front are few enough."""
     G = state.G[state.ok]
-    return affordable(state.F[state.ok], np.all((G >= limits.lower) & (G <= limits.upper), axis=1))
+    return affordable(state.F[state.ok], limits.met(G))
 
 
 def _propose_front(state: _State, limits: LimitModels, objectives: OutputModels, q: int, rng: np.random.Generator,
@@ -205,7 +205,7 @@ def _propose_front(state: _State, limits: LimitModels, objectives: OutputModels,
     """``q`` designs by expected hypervolume improvement (:mod:`~mechopt.optimize.auto.hypervolume_proposal`)."""
     ok = state.ok
     U, F, G = state.U[ok], state.F[ok], state.G[ok]
-    met = np.all((G >= limits.lower) & (G <= limits.upper), axis=1)
+    met = limits.met(G)
     if limits.m:
         limits.fit(U, G, rng)
     objectives.fit(U, F, rng)
