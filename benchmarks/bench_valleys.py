@@ -11,6 +11,10 @@ Run, e.g.::
     nice -n 10 python benchmarks/bench_valleys.py --dims 3 6 --methods auto py_bobyqa --seeds 10
     nice -n 10 python benchmarks/bench_valleys.py --suite-bar --cache bench_suite_bar.json
     python benchmarks/bench_valleys.py --table
+    nice -n 10 python benchmarks/bench_valleys.py --aligned --methods auto --dims 3 6 --cache aligned.json
+
+``--aligned`` runs the same valleys with R = Q = I, their axes along the variables: how far a perfectly learned
+rotation of the inputs could take a method.
 """
 
 from __future__ import annotations
@@ -42,6 +46,8 @@ KINDS = sorted({name.removeprefix("valley_").rstrip("0123456789") for name in VA
 #: COBYQA as scipy runs it: one start given the whole budget (the table's ``cobyqa`` splits it over 3 starts by
 #: default; leftovers of a converged start go to fresh starts either way).
 OPTIONS = {"cobyqa": {"n_starts": 1}}
+#: Suffix of a valley's name in the cache and the table when it runs axis-aligned (``--aligned``).
+ALIGNED = "_aligned"
 SUITE_BAR = sorted(n for n, c in SUITE.items() if not issubclass(c, Valley) and c().dim in (3, 4))
 
 
@@ -75,16 +81,25 @@ def load(path: Path) -> dict[str, dict]:
     return json.loads(path.read_text()) if path.exists() else {}
 
 
-def run_grid(functions: list[str], budgets: list[str], methods: list[str], seeds: int, path: Path) -> None:
+def aligned(p: TestFunction) -> TestFunction:
+    """The valley ``p`` with R = Q = I: its axes along the variables, as a perfectly learned rotation would make it
+    for a model with one length-scale per variable (the same shift, f* and box)."""
+    p.rotation = p.second_rotation = np.eye(p.dim)
+    p.name = f"{p.name}{ALIGNED}"
+    return p
+
+
+def run_grid(functions: list[str], budgets: list[str], methods: list[str], seeds: int, path: Path,
+             axis_aligned: bool = False) -> None:
     """Every run not yet in the cache, method by method (so a part of the grid ends with whole cells)."""
     cache = load(path)
     for method in methods:
         for name in functions:
-            p = SUITE[name]()
+            p = aligned(SUITE[name]()) if axis_aligned else SUITE[name]()
             for b in budgets:
                 budget = budget_of(b, p.dim)
                 for seed in range(seeds):
-                    k = key(method, name, budget, seed)
+                    k = key(method, p.name, budget, seed)
                     if k in cache:
                         continue
                     cache[k] = row = run_one(p, method, budget, seed)
@@ -92,7 +107,7 @@ def run_grid(functions: list[str], budgets: list[str], methods: list[str], seeds
                     tmp.write_text(json.dumps(cache, indent=0))
                     tmp.replace(path)  # a run killed mid-write leaves the previous cache whole
                     raised = f" RAISED {row['raised']}" if row["raised"] else ""
-                    print(f"{name:26s} {method:16s} {budget:4d} seed {seed}: f - f* {row['error']:.4g} "
+                    print(f"{p.name:26s} {method:16s} {budget:4d} seed {seed}: f - f* {row['error']:.4g} "
                           f"({row['seconds']:.1f} s, {row['nfev']} sims){raised}", flush=True)
 
 
@@ -145,6 +160,8 @@ def main() -> None:
     ap.add_argument("--cache", default="bench_valleys.json")
     ap.add_argument("--suite-bar", action="store_true", help="auto, GPSampler and BoTorch at 30 on the 3-D/4-D suite")
     ap.add_argument("--table", action="store_true", help="only print the table of --cache")
+    ap.add_argument("--aligned", action="store_true",
+                    help="the valleys with R = Q = I (what a perfectly learned rotation would give)")
     args = ap.parse_args()
     if args.suite_bar:
         args.functions = args.functions or SUITE_BAR
@@ -155,7 +172,9 @@ def main() -> None:
     functions = args.functions or [f"valley_{k}{d}" for d in args.dims for k in args.kinds]
     print(header(), flush=True)
     if not args.table:
-        run_grid(functions, args.budgets, args.methods, args.seeds, Path(args.cache))
+        run_grid(functions, args.budgets, args.methods, args.seeds, Path(args.cache), args.aligned)
+    if args.aligned:
+        functions = [f + ALIGNED for f in functions]
     print("\nmedian f - f* over the seeds (the count in brackets where a cell has fewer seeds than the others)")
     print(table(Path(args.cache), args.methods, functions))
 
