@@ -33,11 +33,12 @@ import bench_unseen  # noqa: E402
 
 import mechopt.optimize.auto.quadratic_steps as quadratic_steps  # noqa: E402
 from mechopt import minimize  # noqa: E402
+from mechopt.studies.benchmark_functions import TestFunction  # noqa: E402
 
 _PROPOSE = quadratic_steps.QuadraticSteps.propose
 
 
-def _run(name: str, seed: int, steps_on: bool) -> tuple[float, int]:
+def _run(cls: type[TestFunction], budget: int, seed: int, steps_on: bool) -> tuple[float, int]:
     """Gap in % of the range at the answer of one seeded run, and the quadratic steps it took."""
     taken = [0]
 
@@ -51,11 +52,10 @@ def _run(name: str, seed: int, steps_on: bool) -> tuple[float, int]:
 
     quadratic_steps.QuadraticSteps.propose = counting if steps_on else never
     try:
-        cls = bench_unseen.problem_class(name)
         p = cls()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            r = minimize(p, bench_unseen.FUNCTIONS[name][5], method="auto", seed=seed)
+            r = minimize(p, budget, method="auto", seed=seed)
     finally:
         quadratic_steps.QuadraticSteps.propose = _PROPOSE
     return 100.0 * (float(r.fun) - p.f_min) / p.f_range, taken[0]
@@ -69,10 +69,12 @@ def main() -> None:
     args = ap.parse_args()
     rows = []
     for name in args.functions:
+        # Once per function: the class estimates the range from 200,000 random designs.
+        cls, budget = bench_unseen.problem_class(name), bench_unseen.FUNCTIONS[name][5]
         for seed in range(args.seeds):
-            on, steps = _run(name, seed, True)
-            off = _run(name, seed, False)[0] if steps else on
-            rows.append({"function": name, "budget": bench_unseen.FUNCTIONS[name][5], "seed": seed,
+            on, steps = _run(cls, budget, seed, True)
+            off = _run(cls, budget, seed, False)[0] if steps else on
+            rows.append({"function": name, "budget": budget, "seed": seed,
                          "gap_on": on, "gap_off": off, "steps": steps})
             print(json.dumps(rows[-1]), flush=True)
     print("\n| function | budget | without the steps | halves | with | halves | steps taken |")

@@ -163,6 +163,8 @@ def main() -> None:
     ap.add_argument("--aligned", action="store_true",
                     help="the valleys with R = Q = I (what a perfectly learned rotation would give)")
     args = ap.parse_args()
+    if args.aligned and (args.functions or args.suite_bar):
+        ap.error("--aligned takes the valleys only (--kinds, --dims), not --functions or --suite-bar")
     if args.suite_bar:
         args.functions = args.functions or SUITE_BAR
         if args.budgets == ap.get_default("budgets"):
