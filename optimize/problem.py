@@ -96,6 +96,12 @@ class DesignProblem(DeclaredObjectives, AllowedDesigns):
     limits : dict
         ``{output: (lower, upper)}``, either bound None, in the output's unit: a simulated design outside is kept
         in the store and infeasible in every answer.
+    ideal, nadir : array_like, optional
+        Not declared by default.  A problem with several objectives may give the least and the largest value of
+        each minimised objective over its front (as the test problems of
+        :mod:`~mechopt.studies.multi_objective_functions` do): the result's hypervolume is then normalised by them,
+        and the default method's search measures its proposals on the same scale.  Give them only when they are
+        the front's known bounds: a loose guess measured worse than none (``docs/guide/trade_offs.md``).
     fit : str
         ``"square"`` (the model fits the objective squared, as T_RMS² for an RMS torque) or ``"value"``.
     output_units : dict

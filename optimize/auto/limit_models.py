@@ -28,11 +28,13 @@ class LimitModels:
     ----------
     lower, upper : (m,) ndarray
         The limits, in the outputs' units (-inf / +inf where open).
+    prior : bool
+        Fit the outputs' GPs with the length-scale prior (:class:`OutputModels`).
     """
 
-    def __init__(self, lower: np.ndarray, upper: np.ndarray) -> None:
+    def __init__(self, lower: np.ndarray, upper: np.ndarray, prior: bool = False) -> None:
         self.lower, self.upper = np.asarray(lower, float), np.asarray(upper, float)
-        self._outputs = OutputModels(self.lower.size)
+        self._outputs = OutputModels(self.lower.size, prior)
 
     @property
     def m(self) -> int:

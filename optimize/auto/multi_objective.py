@@ -3,7 +3,9 @@ simulated outputs (constrained EI).
 
 Several objectives are handled by the expected hypervolume improvement of
 :mod:`~mechopt.optimize.auto.hypervolume_proposal`: one GP per objective, the closed-form EHVI of the current
-feasible front, batches of W workers by believed fronts.  ParEGO (Knowles 2006) is the alternative
+feasible front, batches of W workers by believed fronts.  A problem that declares its objectives' ``ideal`` and
+``nadir`` fixes the normalisation of the improvement, and every GP of the search then takes the length-scale
+prior.  ParEGO (Knowles 2006) is the alternative
 (``scalarise=True``, the option ``front="parego"``), and the fallback when the front's box decomposition would grow
 past :data:`~mechopt.optimize.auto.hypervolume_proposal.MOST_BOXES` (four objectives and a large front): each
 proposal draws a weight vector λ uniformly from the simplex, scalarises the normalised objectives of every simulated
@@ -201,7 +203,8 @@ def _front_affordable(state: _State, limits: LimitModels) -> bool:
 
 
 def _propose_front(state: _State, limits: LimitModels, objectives: OutputModels, q: int, rng: np.random.Generator,
-                   margins: Callable[[np.ndarray], np.ndarray] | None) -> np.ndarray:
+                   margins: Callable[[np.ndarray], np.ndarray] | None,
+                   declared: tuple[np.ndarray, np.ndarray] | None) -> np.ndarray:
     """``q`` designs by expected hypervolume improvement (:mod:`~mechopt.optimize.auto.hypervolume_proposal`)."""
     ok = state.ok
     U, F, G = state.U[ok], state.F[ok], state.G[ok]
@@ -219,13 +222,14 @@ def _propose_front(state: _State, limits: LimitModels, objectives: OutputModels,
 
     use_lf = limits.m > 0 or success is not None
     return propose_by_hypervolume(U, F, met, objectives, q, rng, state.allowed, log_feasible if use_lf else None,
-                                  margins)
+                                  margins, declared)
 
 
 def trade_off_search(evaluate: TradeOffEvaluator, bounds: np.ndarray, budget: int, k: int, lower: np.ndarray,
                      upper: np.ndarray, seed: int = 0, feasible: Callable[[np.ndarray], np.ndarray] | None = None,
                      batch: int = 1, margins: Callable[[np.ndarray], np.ndarray] | None = None,
-                     initial: np.ndarray | None = None, scalarise: bool = False) -> TradeOffRun:
+                     initial: np.ndarray | None = None, scalarise: bool = False,
+                     declared: tuple[np.ndarray, np.ndarray] | None = None) -> TradeOffRun:
     """Spend ``budget`` simulations on a Pareto front (k > 1) or on the best design meeting the limits (k = 1).
 
     Parameters
@@ -253,6 +257,10 @@ def trade_off_search(evaluate: TradeOffEvaluator, bounds: np.ndarray, budget: in
     scalarise : bool
         Several objectives by ParEGO's random scalarisations throughout, instead of the expected hypervolume
         improvement (which the search leaves for ParEGO only when the front outgrows its box decomposition).
+    declared : (ideal (k,), nadir (k,)), optional
+        The objectives' scale the problem declares (minimised sense; k > 1).  The expected hypervolume improvement
+        then normalises by it (:func:`~mechopt.optimize.auto.hypervolume_proposal.propose_by_hypervolume`) and
+        every GP of the search takes the length-scale prior.
 
     Returns
     -------
@@ -261,20 +269,26 @@ def trade_off_search(evaluate: TradeOffEvaluator, bounds: np.ndarray, budget: in
     bounds = np.asarray(bounds, dtype=float)
     d = bounds.shape[0]
     rng = np.random.default_rng(seed)
-    limits = LimitModels(lower, upper)
+    declared = declared if k > 1 else None
+    # With a fixed reference a design predicted beyond it earns nothing, and the search follows the models'
+    # extrapolation into the box: plain marginal likelihood left DTLZ2-3's distance variables at the length-scales'
+    # floor or ceiling, a model that never finds the front; the prior keeps them resolvable (BoTorch's default).
+    # With the front's own scale the prior measured worse (docs/guide/trade_offs.md).
+    prior = declared is not None
+    limits = LimitModels(lower, upper, prior)
     state = _State(evaluate, bounds, int(budget), k, limits.m, feasible)
     unit_margins = None if margins is None else (lambda U: margins(state.to_x(U)))
     with _limited_threads():
         if initial is not None and len(initial):
             state.simulate((np.atleast_2d(np.asarray(initial, float)) - state.lo) / state.width)
         state.simulate(_space_filling(state, max(0, initial_size(d, int(budget)) - state.U.shape[0]), rng))
-        model, objectives = _Scalarised(), OutputModels(k)
+        model, objectives = _Scalarised(), OutputModels(k, prior)
         while state.remaining > 0:
             q = min(max(1, int(batch)), state.remaining)
             if state.ok.sum() < 2:
                 U = _space_filling(state, q, rng)
             elif k > 1 and scalarise is False and _front_affordable(state, limits):
-                U = _propose_front(state, limits, objectives, q, rng, unit_margins)
+                U = _propose_front(state, limits, objectives, q, rng, unit_margins, declared)
             else:
                 U = _propose(state, limits, model, q, rng, unit_margins)
             if not U.shape[0]:

@@ -22,10 +22,14 @@ class OutputModels:
     ----------
     m : int
         Number of outputs.
+    prior : bool
+        Fit with the length-scale prior of :func:`~mechopt.optimize.auto.gp.fit_gp` (the trade-off search's choice
+        when the problem declares its objectives' scale, :mod:`~mechopt.optimize.auto.multi_objective`), or by
+        plain marginal likelihood with the spacing floor (default).
     """
 
-    def __init__(self, m: int) -> None:
-        self.m = int(m)
+    def __init__(self, m: int, prior: bool = False) -> None:
+        self.m, self.prior = int(m), bool(prior)
         self._theta: list[np.ndarray | None] = [None] * self.m
         self._fitted_n = [0] * self.m
         self.models: list[tuple[GaussianProcess, float, float]] = []
@@ -42,7 +46,7 @@ class OutputModels:
             if full:
                 self._fitted_n[j] = U.shape[0]
             gp = fit_gp(U, (y - mu) / sd, rng, warm=self._theta[j], starts=3 if full else 1,
-                        maxiter=100 if full else 30, prior=False, spacing_floor=True)
+                        maxiter=100 if full else 30, prior=self.prior, spacing_floor=not self.prior)
             self._theta[j] = gp.theta
             self.models.append((gp, mu, sd))
 

@@ -164,3 +164,30 @@ def test_three_objectives_in_batches_beat_as_many_space_filling_designs():
         return moocore.hypervolume(F[moocore.is_nondominated(F)], ref=[1.1, 1.1, 1.1])
 
     assert hv(run.F) > 1.1 * hv(sobol)
+
+
+def test_a_bad_declared_scale_is_refused_in_one_line_before_any_simulation(tmp_path):
+    path = tmp_path / "s.sqlite"
+    with pytest.raises(InputError, match=r"ideal = \[0.0, 0.0\], nadir = \[1.0\]; expected 2 finite values") as err:
+        mechopt.minimize(_variant(Zdt1, ideal=(0.0, 0.0), nadir=(1.0,)), budget=10, store=path)
+    assert "\n" not in str(err.value)
+    with pytest.raises(InputError, match="every nadir above its ideal"):
+        mechopt.minimize(_variant(Zdt1, ideal=(0.0, 1.0), nadir=(1.0, 1.0)), budget=10, store=path)
+    with SampleStore(path) as store:
+        assert store.count() == 0
+
+
+def test_a_declared_scale_draws_dtlz2_3_onto_its_front():
+    # DTLZ2-3 declares its front's ideal and nadir; with them the search normalises and scores its proposals as the
+    # result does.  Seeds 0-4 at 50 simulations: a median hypervolume of 0.52 with the declared scale, 0.39 with
+    # the front's own (docs/guide/trade_offs.md); Optuna TPE's median over 10 seeds is 0.40.
+    from mechopt.optimize.pareto import front_mask, hypervolume, normalisation
+    from mechopt.studies.multi_objective_functions import MULTI_OBJECTIVE_SUITE
+
+    p = MULTI_OBJECTIVE_SUITE["dtlz2-3"]()
+    hvs = []
+    for seed in range(5):
+        F = mechopt.minimize(p, budget=50, seed=seed).simulated["F"]
+        front = F[front_mask(F)]
+        hvs.append(hypervolume(front, normalisation(front, p.ideal, p.nadir)))
+    assert np.median(hvs) > 0.47
