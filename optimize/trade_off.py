@@ -16,7 +16,7 @@ from mechopt.errors import InputError
 from mechopt.optimize.auto.multi_objective import trade_off_search
 from mechopt.optimize.problem import DesignProblem
 from mechopt.optimize.result import OptimizeResult
-from mechopt.optimize.trade_off_answer import trade_off_answer
+from mechopt.optimize.trade_off_answer import declared_scale, trade_off_answer
 from mechopt.runs.store import design_key
 
 __all__ = ["check_trade_off_method", "run_trade_off"]
@@ -57,19 +57,6 @@ def _missing_output(problem: DesignProblem, records: list) -> None:
                 raise InputError(f"problem {problem.name!r}: the {role} names output {name!r}, which the simulator "
                                  f"did not return at the first design ({problem.describe(r.design)}); expected it "
                                  f"among its outputs ({r.error})")
-
-
-def _declared_scale(problem: DesignProblem) -> tuple[np.ndarray, np.ndarray] | None:
-    """The problem's ``ideal`` and ``nadir`` (minimised objectives, both or neither), checked in one line."""
-    ideal, nadir = getattr(problem, "ideal", None), getattr(problem, "nadir", None)
-    if ideal is None or nadir is None:
-        return None
-    k = problem.objective_spec.k
-    ideal, nadir = np.asarray(ideal, dtype=float).ravel(), np.asarray(nadir, dtype=float).ravel()
-    if ideal.size != k or nadir.size != k or not (np.all(np.isfinite(ideal)) and np.all(nadir > ideal)):
-        raise InputError(f"ideal = {ideal.tolist()}, nadir = {nadir.tolist()}; expected {k} finite values each, "
-                         "every nadir above its ideal (minimised objectives)")
-    return ideal, nadir
 
 
 def run_trade_off(problem: DesignProblem, budget: int, seed: int, sampler, initial: np.ndarray | None = None,
@@ -125,7 +112,7 @@ def run_trade_off(problem: DesignProblem, budget: int, seed: int, sampler, initi
         run = trade_off_search(evaluate, problem.bounds, budget, spec.k, limits.lower, limits.upper, seed=seed,
                                feasible=problem.feasible, batch=sampler.batch_size,
                                margins=margins if problem.constraints else None, initial=initial,
-                               scalarise=scalarise, declared=_declared_scale(problem))
+                               scalarise=scalarise, declared=declared_scale(problem))
     finally:
         sampler.watchers.remove(watch)
     answer = trade_off_answer(problem, run.X, run.F, run.G, run.ok, outputs)

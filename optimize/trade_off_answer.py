@@ -8,13 +8,27 @@ from typing import Any
 
 import numpy as np
 
+from mechopt.errors import InputError
 from mechopt.optimize.pareto import front_mask, hypervolume, hypervolume_trace, normalisation
 from mechopt.optimize.problem import DesignProblem
 
-__all__ = ["CLOSEST", "trade_off_answer", "violation"]
+__all__ = ["CLOSEST", "declared_scale", "trade_off_answer", "violation"]
 
 #: Designs returned when none is feasible: the ones that break the margins and limits least.
 CLOSEST = 5
+
+
+def declared_scale(problem: DesignProblem) -> tuple[np.ndarray, np.ndarray] | None:
+    """The problem's ``ideal`` and ``nadir`` (minimised objectives, both or neither), checked in one line."""
+    ideal, nadir = getattr(problem, "ideal", None), getattr(problem, "nadir", None)
+    if ideal is None or nadir is None:
+        return None
+    k = problem.objective_spec.k
+    ideal, nadir = np.asarray(ideal, dtype=float).ravel(), np.asarray(nadir, dtype=float).ravel()
+    if ideal.size != k or nadir.size != k or not (np.all(np.isfinite(ideal)) and np.all(nadir > ideal)):
+        raise InputError(f"ideal = {ideal.tolist()}, nadir = {nadir.tolist()}; expected {k} finite values each, "
+                         "every nadir above its ideal (minimised objectives)")
+    return ideal, nadir
 
 
 def violation(problem: DesignProblem, X: np.ndarray, G: np.ndarray, ok: np.ndarray) -> np.ndarray:
@@ -80,7 +94,7 @@ def trade_off_answer(problem: DesignProblem, X: np.ndarray, F: np.ndarray, G: np
                            f"{limits.describe() or 'the margins'}"}
     front = idx[front_mask(F[idx])]
     front = front[np.argsort(F[front, 0], kind="stable")]
-    norm = normalisation(F[front], getattr(problem, "ideal", None), getattr(problem, "nadir", None))
+    norm = normalisation(F[front], *(declared_scale(problem) or (None, None)))
     hv = hypervolume(F[front], norm)
     return {"x": X[front].copy(), "fun": F[front].copy(), "success": True, "feasible": np.ones(front.size, bool),
             "front_outputs": [dict(outputs[i] or {}) for i in front], "front_index": front,

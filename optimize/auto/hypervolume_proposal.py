@@ -43,9 +43,14 @@ SPARSE_UP_TO = 2
 EXTEND_EVERY = {2: 2, 3: 3, 4: 4}
 
 
-def _front_scale(F: np.ndarray, met: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Front (p, k) of the designs meeting the limits, and the ideal and span that map it to [0, 1]."""
+def _front_scale(F: np.ndarray, met: np.ndarray,
+                 declared: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Front (p, k) of the designs meeting the limits, and the ideal and span that map it to [0, 1] (the declared
+    ideal and nadir's when given)."""
     front = F[met][front_mask(F[met])] if met.any() else np.zeros((0, F.shape[1]))
+    if declared is not None:
+        ideal = np.asarray(declared[0], float)
+        return front, ideal, np.maximum(np.asarray(declared[1], float) - ideal, 1e-300)
     source = front if front.shape[0] > 1 else F
     ideal = source.min(axis=0)
     span = np.ptp(source, axis=0)
@@ -92,10 +97,7 @@ def propose_by_hypervolume(U: np.ndarray, F: np.ndarray, met: np.ndarray, object
     (p, d) ndarray
         p <= q designs (fewer when no allowed candidate is left).
     """
-    front, ideal, span = _front_scale(F, met)
-    if declared is not None:
-        ideal = np.asarray(declared[0], float)
-        span = np.maximum(np.asarray(declared[1], float) - ideal, 1e-300)
+    front, ideal, span = _front_scale(F, met, declared)
     Z = (front - ideal) / span
     reference = np.full(F.shape[1], REFERENCE_MARGIN)
     # One proposal in k extends the front: its reference lies beyond the worst feasible design.
